@@ -1,0 +1,33 @@
+#pragma once
+
+#include <Eigen/Core>
+
+#include "mresim/pair/pair_energy.hpp"
+
+namespace mresim::pair {
+
+struct RelaxOptions {
+  double gradient_tolerance = 1e-12;  // on |dE/dd| in units of mu0 Ms^2 V / R
+  int max_iterations = 2000;
+  double max_step = 0.25;             // largest move per iteration, in units of R
+  double step_tolerance = 1e-13;      // converged when a Newton step at positive curvature is
+                                      // shorter than this (relative to |d|)
+};
+
+struct RelaxResult {
+  Eigen::Vector3d separation;  // d = r1 - r2 in metres
+  int iterations = 0;
+  bool converged = false;
+};
+
+// Local energy minimisation from a starting configuration, so that a field sweep follows its
+// branch (Section 2.4). The single-spring model relaxes only S along the fixed pair axis x (it
+// has no rotational restoring force, Section 2.4); the three-spring model relaxes the full
+// separation vector. Method: Newton's method on the exact gradient with a finite-difference
+// Hessian of it, negative curvature flipped to descend (saddle-free Newton), steps capped at
+// max_step and accepted by an Armijo line search, so the energy never increases and a pair
+// cannot tunnel through the overlap penalty.
+RelaxResult relax(const PairEnergy& energy, SpringModel model, const Eigen::Vector3d& start,
+                  const RelaxOptions& options = {});
+
+}  // namespace mresim::pair
