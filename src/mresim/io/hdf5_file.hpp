@@ -1,0 +1,77 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace mresim::io {
+
+// A results file written through the HDF5 C API. Creating one truncates any file at that path.
+//
+// Paths are HDF5 paths ("/steps/field"; a path without a leading '/' is taken from the root).
+// Missing intermediate groups are created, so callers never manage groups. Datasets are written
+// once: writing to an existing dataset is an error (it would hide a bug that writes a step
+// twice); attributes may be overwritten. Every numeric dataset carries a string attribute
+// "unit" (SI; use "1" for dimensionless). Strings are UTF-8, variable length, so h5py reads them
+// as Python str. Every failure throws std::runtime_error naming the file and the object.
+//
+// HDF5 as packaged in Debian is not thread-safe: write from one thread only.
+class Hdf5File {
+ public:
+  explicit Hdf5File(const std::filesystem::path& file);
+  ~Hdf5File();
+  Hdf5File(Hdf5File&& other) noexcept;
+  Hdf5File& operator=(Hdf5File&& other) noexcept;
+  Hdf5File(const Hdf5File&) = delete;
+  Hdf5File& operator=(const Hdf5File&) = delete;
+
+  [[nodiscard]] const std::filesystem::path& path() const { return path_; }
+
+  // Whether a group or dataset exists at `object_path` ("/" always exists).
+  [[nodiscard]] bool exists(std::string_view object_path) const;
+  // Creates the group and any missing parents; nothing happens if it exists.
+  void create_group(std::string_view group_path);
+
+  // Attributes on a group or dataset ("/" is the file's root group). A missing group is created.
+  void write_string_attribute(std::string_view object_path, std::string_view name,
+                              std::string_view value);
+  void write_number_attribute(std::string_view object_path, std::string_view name, double value);
+  void write_int_attribute(std::string_view object_path, std::string_view name, std::int64_t value);
+
+  void write_vector(std::string_view dataset_path, const std::vector<double>& values,
+                    std::string_view unit);
+  // `unit` is stored only when not empty (counts and indices usually have none).
+  void write_int_vector(std::string_view dataset_path, const std::vector<std::int64_t>& values,
+                        std::string_view unit = {});
+  // A rows x cols dataset from row-major data (row i is values[i*cols .. i*cols+cols-1]).
+  void write_matrix(std::string_view dataset_path, std::size_t rows, std::size_t cols,
+                    const std::vector<double>& row_major, std::string_view unit);
+  // Any rank (e.g. steps x particles x 3), C order, dims.size() >= 1.
+  void write_array(std::string_view dataset_path, const std::vector<std::size_t>& dims,
+                   const std::vector<double>& c_order, std::string_view unit);
+  void write_string_vector(std::string_view dataset_path, const std::vector<std::string>& values);
+
+  // Pushes buffered data to disk (useful before a long computation step).
+  void flush();
+  // Closes the file, reporting errors; the destructor closes silently. Further writes throw.
+  void close();
+
+ private:
+  [[noreturn]] void fail(std::string_view action, std::string_view object_path) const;
+  void require_open(std::string_view object_path) const;
+  // Opens the object (creating the group if it does not exist); returns an hid_t.
+  [[nodiscard]] std::int64_t open_object(std::string_view object_path);
+  void write_attribute(std::string_view object_path, std::string_view name, std::int64_t type,
+                       const void* value);
+  void write_dataset(std::string_view dataset_path, std::int64_t file_type,
+                     std::int64_t memory_type, const std::vector<std::size_t>& dims,
+                     const void* data, std::string_view unit);
+
+  std::filesystem::path path_;
+  std::int64_t file_ = -1;  // hid_t; kept as int64 so this header does not need hdf5.h
+};
+
+}  // namespace mresim::io

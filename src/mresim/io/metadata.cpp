@@ -1,0 +1,25 @@
+#include "mresim/io/metadata.hpp"
+
+#include <ctime>
+#include <mresim/core/version.hpp>
+
+namespace mresim::io {
+
+std::string utc_timestamp() {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char buffer[32];
+  std::strftime(buffer, sizeof buffer, "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return buffer;
+}
+
+void write_run_metadata(Hdf5File& file, const config::TableReader& root, std::string run_type) {
+  file.write_string_attribute("/", "mresim_version", kVersion);
+  file.write_string_attribute("/", "run_type", run_type);
+  file.write_string_attribute("/", "input_toml", root.source_text());
+  file.write_string_attribute("/", "input_file", root.source_name());
+  file.write_string_attribute("/", "created_utc", utc_timestamp());
+}
+
+}  // namespace mresim::io

@@ -1,0 +1,21 @@
+#pragma once
+
+#include <string>
+
+#include "mresim/config/table_reader.hpp"
+#include "mresim/io/hdf5_file.hpp"
+
+namespace mresim::io {
+
+// Records what is needed to reproduce a run as attributes of the root group of results.h5:
+//   mresim_version  program version (mresim::kVersion)
+//   run_type        [run].type
+//   input_toml      the complete run file, byte for byte
+//   input_file      the name the run file was read under
+//   created_utc     ISO 8601 time stamp, e.g. 2025-01-31T14:05:09Z
+void write_run_metadata(Hdf5File& file, const config::TableReader& root, std::string run_type);
+
+// The current time as "YYYY-MM-DDTHH:MM:SSZ".
+std::string utc_timestamp();
+
+}  // namespace mresim::io
