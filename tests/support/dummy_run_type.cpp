@@ -1,0 +1,67 @@
+// A tiny run type that exists only in test builds (mresim_tests and the mresim_testbed
+// executable), so the registry, `mresim run` and `mresim info` can be tested end to end without
+// depending on any physics module.
+//
+//   [run]
+//   type = "test_dummy"
+//   [dummy]
+//   steps = 4         # integer >= 1
+//   scale = 0.5       # m, > 0 (default 1)
+//   fail_at = 2       # optional: throw at this step, to test cleanup
+
+#include <omp.h>
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "mresim/app/run_type.hpp"
+#include "mresim/io/csv_writer.hpp"
+
+namespace {
+
+using mresim::config::Range;
+
+class DummyPlan final : public mresim::app::RunPlan {
+ public:
+  explicit DummyPlan(const mresim::config::TableReader& root) {
+    const auto dummy = root.table("dummy");
+    steps_ = dummy.integer("steps", Range::at_least(1));
+    scale_ = dummy.number_or("scale", 1.0, Range::positive(), "m");
+    fail_at_ = dummy.integer_or("fail_at", -1, Range::any());
+  }
+
+  void describe(mresim::app::InfoReport& report) const override {
+    report.add_integer("dummy", "steps", steps_);
+    report.add("dummy", "scale", scale_, "m", "length of one step");
+    report.add("dummy", "total_length", scale_ * static_cast<double>(steps_), "m");
+  }
+
+  void execute(const std::filesystem::path& staging_dir, mresim::io::Hdf5File& results,
+               mresim::app::Progress& progress) const override {
+    progress.set_total(static_cast<std::size_t>(steps_));
+    std::vector<double> values;
+    mresim::io::CsvWriter csv(staging_dir / "summary.csv", {"step", "value_m"});
+    for (long i = 0; i < steps_; ++i) {
+      if (i == fail_at_) throw std::runtime_error("dummy failure at step " + std::to_string(i));
+      values.push_back(scale_ * static_cast<double>(i));
+      csv.row({static_cast<double>(i), values.back()});
+      progress.advance();
+    }
+    csv.close();
+    results.write_vector("/dummy/values", values, "m");
+    results.write_int_attribute("/dummy", "threads", omp_get_max_threads());
+  }
+
+ private:
+  long steps_ = 0;
+  double scale_ = 1.0;
+  long fail_at_ = -1;
+};
+
+const mresim::app::RunTypeRegistrar registrar({"test_dummy", "Test-only run type",
+                                               [](const mresim::config::TableReader& root) {
+                                                 return std::make_unique<DummyPlan>(root);
+                                               }});
+
+}  // namespace
