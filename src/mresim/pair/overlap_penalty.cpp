@@ -16,6 +16,11 @@ PenaltyValue tanh_penalty(const OverlapPenalty& p, double radius, double s) {
   const double sech = 2.0 / (std::exp(x) + std::exp(-x));
   // dE/dS = E_max/2 sech^2(x) * (1/delta) * du/dS, du/dS = -1/S^2.
   v.derivative = -0.5 * p.e_max * sech * sech / (p.delta * s * s);
+  // d/dS of E_max/2 sech^2(x) x' with x' = -1/(delta S^2): (sech^2)' = -2 sech^2 tanh x'.
+  const double x_prime = -1.0 / (p.delta * s * s);
+  const double x_second = 2.0 / (p.delta * s * s * s);
+  v.second_derivative =
+      0.5 * p.e_max * sech * sech * (-2.0 * std::tanh(x) * x_prime * x_prime + x_second);
   return v;
 }
 
@@ -24,13 +29,14 @@ PenaltyValue tanh_penalty(const OverlapPenalty& p, double radius, double s) {
 PenaltyValue wca_penalty(const OverlapPenalty& p, double s) {
   PenaltyValue v;
   if (s > p.r_cut) return v;
-  auto lj = [&](double r) {
-    const double q6 = std::pow(p.r_min / r, 6);
-    return q6 * q6 - q6;
-  };
+  // Factored forms: E_max is ~1e8 times the magnetic energy scale, so the textbook sum
+  // q^12 - q^6 + 1/4 would lose all significant digits to cancellation near the cut-off.
+  // (q12 - q6) - (qc12 - qc6) = (q6 - qc6)(q6 + qc6 - 1).
   const double q6 = std::pow(p.r_min / s, 6);
-  v.energy = 4.0 * p.e_max * (q6 * q6 - q6 - lj(p.r_cut));
-  v.derivative = 4.0 * p.e_max * (-12.0 * q6 * q6 + 6.0 * q6) / s;
+  const double qc6 = std::pow(p.r_min / p.r_cut, 6);
+  v.energy = 4.0 * p.e_max * (q6 - qc6) * (q6 + qc6 - 1.0);
+  v.derivative = -24.0 * p.e_max * q6 * (2.0 * q6 - 1.0) / s;
+  v.second_derivative = 4.0 * p.e_max * (156.0 * q6 * q6 - 42.0 * q6) / (s * s);
   return v;
 }
 

@@ -4,10 +4,11 @@
 
 namespace mresim::pair {
 
-// Energy (J) and its derivative dE/dS (J/m) of the overlap penalty at centre distance S (m).
+// Energy (J) and its derivatives dE/dS, d2E/dS2 of the overlap penalty at centre distance S (m).
 struct PenaltyValue {
   double energy = 0.0;
   double derivative = 0.0;
+  double second_derivative = 0.0;  // J/m^2, for the relaxation's Newton steps
 };
 
 PenaltyValue overlap_penalty(const OverlapPenalty& penalty, double radius, double separation);

@@ -51,22 +51,47 @@ double PairEnergy::scaled_energy_and_gradient(const Eigen::Vector3d& d,
   return scaled_terms(d, mag).total();
 }
 
+Eigen::Vector3d PairEnergy::magnetic_gradient(const Eigen::Vector3d& d,
+                                              const Eigen::Vector3d& m) const {
+  const double s2 = d.squaredNorm();
+  const double s5 = s2 * s2 * std::sqrt(s2);
+  const double dm = d.dot(m);
+  // d/dd of -m.D m = -((d.m)^2 / S^5 - m^2 / (3 S^3)) at fixed m.
+  return -2.0 * dm / s5 * m + (5.0 * dm * dm / (s5 * s2) - m.squaredNorm() / s5) * d;
+}
+
 Eigen::Vector3d PairEnergy::scaled_gradient_at(const Eigen::Vector3d& d,
                                                const Eigen::Vector3d& m) const {
-  const double s2 = d.squaredNorm();
-  const double s = std::sqrt(s2);
-  const double s5 = s2 * s2 * s;
-  const double dm = d.dot(m);
-  // d/dd of -m.D m = -((d.m)^2 / S^5 - m^2 / (3 S^3)).
-  Eigen::Vector3d g =
-      -2.0 * dm / s5 * m + (5.0 * dm * dm / (s5 * s2) - m.squaredNorm() / s5) * d;
-  const Eigen::Vector3d n = d / s;
+  const double s = d.norm();
   const double penalty_slope =
       overlap_penalty(system_.penalty, radius_, s * radius_).derivative * radius_ / energy_scale_;
-  g += (k12_ * (s - rest_) + penalty_slope) * n;
   const Eigen::Vector3d d0(rest_, 0.0, 0.0);
-  g += 0.5 * k0_ * (d - d0);
-  return g;
+  return magnetic_gradient(d, m) + (k12_ * (s - rest_) + penalty_slope) * (d / s) +
+         0.5 * k0_ * (d - d0);
+}
+
+Eigen::Matrix3d PairEnergy::scaled_hessian(const Eigen::Vector3d& d) const {
+  constexpr double kStep = 1e-6;  // the magnetic energy varies on the scale of R
+  Eigen::Matrix3d h;
+  for (int i = 0; i < 3; ++i) {
+    Eigen::Vector3d dp = d, dm = d;
+    dp(i) += kStep;
+    dm(i) -= kStep;
+    h.col(i) = (magnetic_gradient(dp, magnetization(dp).m) -
+                magnetic_gradient(dm, magnetization(dm).m)) /
+               (2.0 * kStep);
+  }
+  h = 0.5 * (h + h.transpose()).eval();
+  // Radial terms f(|d|): Hessian f'' n n^T + (f'/S)(I - n n^T).
+  const double s = d.norm();
+  const Eigen::Vector3d n = d / s;
+  const PenaltyValue p = overlap_penalty(system_.penalty, radius_, s * radius_);
+  const double f1 = k12_ * (s - rest_) + p.derivative * radius_ / energy_scale_;
+  const double f2 = k12_ + p.second_derivative * radius_ * radius_ / energy_scale_;
+  const Eigen::Matrix3d nn = n * n.transpose();
+  h += f2 * nn + (f1 / s) * (Eigen::Matrix3d::Identity() - nn);
+  h += 0.5 * k0_ * Eigen::Matrix3d::Identity();
+  return h;
 }
 
 EnergyBreakdown PairEnergy::breakdown(const Eigen::Vector3d& d) const {

@@ -35,6 +35,11 @@ class PairEnergy {
   // Exact gradient dE/dd (scaled); the magnetization is the constrained minimiser, so its
   // variation does not contribute (envelope theorem).
   Eigen::Vector3d scaled_gradient(const Eigen::Vector3d& d) const;
+  // Hessian (scaled): the springs and the penalty, which depend only on |d| and can be
+  // extremely stiff, analytically; the smooth magnetic part by central differences of its
+  // exact gradient. Splitting them keeps the soft directions (rotation of a clustered pair)
+  // resolved next to a wall 1e13 times stiffer.
+  Eigen::Matrix3d scaled_hessian(const Eigen::Vector3d& d) const;
   // Both at once, with one magnetization solve (the relaxation's hot path).
   double scaled_energy_and_gradient(const Eigen::Vector3d& d, Eigen::Vector3d& gradient) const;
 
@@ -47,6 +52,7 @@ class PairEnergy {
  private:
   EnergyBreakdown scaled_terms(const Eigen::Vector3d& d, const PairMagnetization& mag) const;
   Eigen::Vector3d scaled_gradient_at(const Eigen::Vector3d& d, const Eigen::Vector3d& m) const;
+  Eigen::Vector3d magnetic_gradient(const Eigen::Vector3d& d, const Eigen::Vector3d& m) const;
 
   PairSystem system_;
   Eigen::Vector3d reduced_field_;

@@ -10,8 +10,8 @@ struct RelaxOptions {
   double gradient_tolerance = 1e-12;  // on |dE/dd| in units of mu0 Ms^2 V / R
   int max_iterations = 2000;
   double max_step = 0.25;             // largest move per iteration, in units of R
-  double step_tolerance = 1e-13;      // converged when a Newton step at positive curvature is
-                                      // shorter than this (relative to |d|)
+  double step_tolerance = 1e-13;      // position resolution relative to |d|: a gradient that a
+                                      // displacement this small produces counts as converged
 };
 
 struct RelaxResult {
@@ -22,11 +22,12 @@ struct RelaxResult {
 
 // Local energy minimisation from a starting configuration, so that a field sweep follows its
 // branch (Section 2.4). The single-spring model relaxes only S along the fixed pair axis x (it
-// has no rotational restoring force, Section 2.4); the three-spring model relaxes the full
-// separation vector. Method: Newton's method on the exact gradient with a finite-difference
-// Hessian of it, negative curvature flipped to descend (saddle-free Newton), steps capped at
-// max_step and accepted by an Armijo line search, so the energy never increases and a pair
-// cannot tunnel through the overlap penalty.
+// has no rotational restoring force, Section 2.4); the three-spring model relaxes S and the
+// rotation angle theta in the plane of the field and the zero-field axis. Method: Newton's
+// method on the exact gradient, negative curvature flipped to descend (saddle-free Newton),
+// steps capped at max_step and accepted by an Armijo line search, so the energy never increases
+// and a pair cannot tunnel through the overlap penalty. (The text used nonlinear conjugate
+// gradients; Newton reaches the same local minimum in a handful of iterations.)
 RelaxResult relax(const PairEnergy& energy, SpringModel model, const Eigen::Vector3d& start,
                   const RelaxOptions& options = {});
 
