@@ -67,8 +67,11 @@ std::string last_hdf5_error() {
 }
 
 std::string absolute(std::string_view object_path) {
-  if (object_path.empty()) return "/";
-  return object_path.front() == '/' ? std::string(object_path) : "/" + std::string(object_path);
+  // Built by appending: `"/" + std::string(...)` trips a false GCC 12 -Wrestrict warning.
+  std::string full;
+  if (object_path.empty() || object_path.front() != '/') full += '/';
+  full += object_path;
+  return full;
 }
 
 // A variable-length UTF-8 string type: h5py reads it as str, and there is no size limit.

@@ -1,0 +1,39 @@
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+namespace mresim::cli {
+
+// Each command registers its options on the CLI11 app and runs from the parsed values.
+// Errors propagate as exceptions; main() turns them into messages and exit statuses.
+
+struct RunOptions {
+  std::string file;
+  std::string out;    // empty: ./<run file stem>
+  long threads = -1;  // -1: take [run].threads
+  bool no_plot = false;
+};
+CLI::App* add_run_command(CLI::App& app, RunOptions& options);
+int run_command(const RunOptions& options);
+
+struct InfoOptions {
+  std::string file;
+  bool json = false;
+};
+CLI::App* add_info_command(CLI::App& app, InfoOptions& options);
+int info_command(const InfoOptions& options);
+
+struct PlotOptions {
+  std::string dir;
+};
+CLI::App* add_plot_command(CLI::App& app, PlotOptions& options);
+int plot_command(const PlotOptions& options);
+
+CLI::App* add_types_command(CLI::App& app);
+int types_command();
+
+// "  name   summary" lines for every registered run type.
+std::string run_type_list();
+
+}  // namespace mresim::cli

@@ -1,0 +1,69 @@
+// The `mresim` command: parses the command line, dispatches to one command, and maps failures
+// to one-line messages and exit statuses (see exit_status.hpp and docs/cli.md).
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+#include <mresim/core/version.hpp>
+#include <string>
+
+#include "cli/commands.hpp"
+#include "cli/exit_status.hpp"
+#include "mresim/config/config_error.hpp"
+#include "mresim/io/run_directory.hpp"
+
+namespace {
+
+int report_error(const char* message, int status) {
+  std::fprintf(stderr, "mresim: error: %s\n", message);
+  return status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace mresim::cli;
+
+  CLI::App app{
+      "mresim: particle-resolved simulation of magnetorheological elastomers.\n"
+      "Describe a run in a TOML file, then 'mresim run FILE'. See docs/cli.md and "
+      "docs/run-files.md.",
+      "mresim"};
+  app.set_version_flag("--version", std::string("mresim ") + mresim::kVersion);
+  app.require_subcommand(1);
+
+  RunOptions run_options;
+  InfoOptions info_options;
+  PlotOptions plot_options;
+  CLI::App* run = add_run_command(app, run_options);
+  CLI::App* info = add_info_command(app, info_options);
+  CLI::App* plot = add_plot_command(app, plot_options);
+  CLI::App* types = add_types_command(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "mresim: error: %s\nRun 'mresim --help' for usage.\n", e.what());
+    return kInvalidInput;
+  }
+
+  try {
+    if (*run) return run_command(run_options);
+    if (*info) return info_command(info_options);
+    if (*plot) return plot_command(plot_options);
+    if (*types) return types_command();
+  } catch (const mresim::config::ConfigError& e) {
+    return report_error(e.what(), kInvalidInput);
+  } catch (const mresim::io::OutputDirectoryError& e) {
+    return report_error(e.what(), kInvalidInput);
+  } catch (const std::exception& e) {
+    return report_error(e.what(), kFailure);
+  }
+  return kFailure;  // unreachable: require_subcommand(1)
+}

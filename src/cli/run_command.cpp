@@ -1,0 +1,76 @@
+// `mresim run FILE`: validate everything, then compute into a staging directory, commit it,
+// and draw the figures.
+
+#include <cstdio>
+#include <filesystem>
+
+#include "cli/commands.hpp"
+#include "cli/exit_status.hpp"
+#include "cli/plotting.hpp"
+#include "mresim/app/run_type.hpp"
+#include "mresim/app/threads.hpp"
+#include "mresim/config/table_reader.hpp"
+#include "mresim/io/hdf5_file.hpp"
+#include "mresim/io/metadata.hpp"
+#include "mresim/io/run_directory.hpp"
+
+namespace mresim::cli {
+
+namespace fs = std::filesystem;
+
+CLI::App* add_run_command(CLI::App& app, RunOptions& options) {
+  CLI::App* run = app.add_subcommand("run", "Run a simulation described by a TOML run file");
+  run->add_option("FILE", options.file, "Run file (TOML), see docs/run-files.md")->required();
+  run->add_option("--out,-o", options.out,
+                  "Output directory (default: ./<FILE without extension>). An earlier mresim "
+                  "run there is replaced; any other existing directory is refused");
+  run->add_option("--threads,-j", options.threads,
+                  "Number of threads; 0 = all cores (default: [run].threads, else all cores)")
+      ->check(CLI::NonNegativeNumber);
+  run->add_flag("--no-plot", options.no_plot, "Do not draw figures/*.png after the run");
+  run->footer("Run types in this build:\n" + run_type_list());
+  return run;
+}
+
+int run_command(const RunOptions& options) {
+  // 1. Parse and validate the whole run file, unknown keys included, before touching the disk.
+  const auto root = config::TableReader::parse_file(options.file);
+  std::string run_type;
+  const auto plan = app::make_plan(root, &run_type);
+  const app::RunSettings settings = app::read_run_settings(root);
+
+  // 2. Claim the output directory (refused if it holds something other than an mresim run).
+  const fs::path out = options.out.empty() ? fs::path(options.file).stem() : fs::path(options.out);
+  io::RunDirectory run_dir(out);
+
+  // 3. Compute into the staging directory; an exception removes it (RunDirectory destructor).
+  const int threads =
+      app::configure_threads(options.threads >= 0 ? options.threads : settings.threads);
+  {
+    io::Hdf5File results(run_dir.path() / io::RunDirectory::kMarkerFile);
+    io::write_run_metadata(results, root, run_type);
+    results.write_string_attribute("/", "title", settings.title);
+    results.write_int_attribute("/", "threads", threads);
+    app::Progress progress(0, run_type);
+    plan->execute(run_dir.path(), results, progress);
+    progress.finish();
+    results.close();
+  }
+
+  // 4. Publish the complete directory in one step.
+  run_dir.commit();
+  std::printf("mresim: results written to %s\n", out.string().c_str());
+  std::fflush(stdout);
+
+  if (options.no_plot) return kSuccess;
+  if (draw_figures(run_dir.final_path()) != 0) {
+    std::fprintf(stderr,
+                 "mresim: error: drawing the figures failed; the results are complete in '%s' "
+                 "(retry with 'mresim plot %s')\n",
+                 out.string().c_str(), out.string().c_str());
+    return kPlotFailed;
+  }
+  return kSuccess;
+}
+
+}  // namespace mresim::cli
