@@ -1,0 +1,187 @@
+// Regression tests against the numbers the dissertation publishes for the two-dipole models
+// (Chapters 2-3; see docs/validation.md for the comparison table).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "mresim/pair/critical_fields.hpp"
+#include "mresim/pair/stiffness.hpp"
+
+namespace mresim::pair {
+namespace {
+
+constexpr double kR = 1.5e-6;
+
+PairSystem single_spring(double k, double s0, PenaltyKind penalty = PenaltyKind::tanh) {
+  PairSystem s;
+  s.springs = {SpringModel::single, k, 0.0, s0};
+  s.penalty = penalty == PenaltyKind::tanh ? OverlapPenalty::tanh_default(kR)
+                                           : OverlapPenalty::wca_default(kR);
+  return s;
+}
+
+PairSystem three_spring_puljiz(double shear_modulus, double s0) {
+  PairSystem s;
+  const PuljizStiffness k = puljiz_stiffness(shear_modulus, kR, s0);
+  s.springs = {SpringModel::three, k.k12, k.k0, s0};
+  s.penalty = OverlapPenalty::wca_default(kR);
+  return s;
+}
+
+double min_displacement(const HysteresisLoop& loop, double s0) {
+  double lowest = 1.0;
+  for (const PairState& s : loop.states) lowest = std::min(lowest, s.distance() - s0);
+  return lowest;
+}
+
+// The release field of a clustered pair along the field: the clustered state stops being a
+// minimum when the saturated-or-linear dipole attraction at the contact distance s_c (units of
+// R) falls below the spring force, 2 m^2 / s_c^4 = k~ (s0 - s_c), with m = chi h / (1 - 2 chi a).
+double analytic_release_field(const PairSystem& p, double k, double contact) {
+  const SphereMaterial& mat = p.material;
+  const double sc = contact / mat.radius;
+  const double s0 = p.springs.rest_separation / mat.radius;
+  const double k_scaled = k * mat.radius * mat.radius / mat.magnetic_energy_scale();
+  const double m = std::sqrt(0.5 * k_scaled * (s0 - sc) * std::pow(sc, 4));
+  const double a = 1.0 / (3.0 * sc * sc * sc);
+  const double h = m * (1.0 - 2.0 * mat.susceptibility * a) / mat.susceptibility;
+  return h * kMu0 * mat.saturation_magnetization;
+}
+
+// Claim C3, Fig. 2.2: k = 4e-2 N/m, S0 = 9 um, field along the axis, +-1 T in 0.01 T steps.
+TEST(Figure22, AxialFieldClustersToSurfaceContactWithABistableRange) {
+  const PairSystem p = single_spring(4e-2, 9e-6);
+  const HysteresisLoop loop = run_hysteresis(p, {});
+  ASSERT_TRUE(std::all_of(loop.states.begin(), loop.states.end(),
+                          [](const PairState& s) { return s.converged; }));
+  EXPECT_NEAR(min_displacement(loop, 9e-6), -6e-6, 1e-9);  // S = D: surface contact
+  const CriticalFields cf = find_critical_fields(p, loop);
+  ASSERT_TRUE(cf.hysteresis);
+  EXPECT_LT(cf.hc1, cf.hc2);
+  EXPECT_NEAR(cf.hc1, analytic_release_field(p, 4e-2, 2 * kR), 1e-4);
+  // Pinched loop: below H_C1 both branches coincide (no remanence).
+  for (const PairState& s : loop.states) {
+    if (std::abs(s.field) < cf.hc1 - 0.01 && s.branch == 1) {
+      const PairState& first = loop.states[static_cast<std::size_t>(std::lround(std::abs(s.field) / 0.01))];
+      EXPECT_NEAR(s.distance(), first.distance(), 1e-12) << s.field;
+    }
+  }
+}
+
+// Claim C4, Fig. 2.3: perpendicular field, repulsion, no hysteresis, max S - S0 ~ 0.4 um.
+TEST(Figure23, PerpendicularFieldRepelsWithoutHysteresis) {
+  const PairSystem p = single_spring(4e-2, 9e-6);
+  SweepOptions sweep;
+  sweep.theta_h_deg = 90.0;
+  const HysteresisLoop loop = run_hysteresis(p, sweep);
+  EXPECT_FALSE(find_critical_fields(p, loop).hysteresis);
+  double largest = 0.0;
+  for (const PairState& s : loop.states) largest = std::max(largest, s.distance() - 9e-6);
+  EXPECT_NEAR(largest, 0.4e-6, 0.05e-6);
+}
+
+// Claim C5 (Section 2.6) at k = 1e-2 N/m, the stiffness at which S0 = 12.2 um still clusters by
+// eq. 2.10. H_C are mu0 H in tesla on the first quadrant (clustering at +H_C2 on the rising
+// branch, release at +H_C1 on the falling branch).
+TEST(Section26, BistableRangeGrowsFromSixToTwelvePointTwoMicrons) {
+  const CriticalFields near = critical_fields_of(single_spring(1e-2, 6e-6), {});
+  const CriticalFields far = critical_fields_of(single_spring(1e-2, 12.2e-6), {});
+  ASSERT_TRUE(near.hysteresis);
+  ASSERT_TRUE(far.hysteresis);
+  EXPECT_NEAR(near.delta(), 0.07, 0.01);
+  EXPECT_NEAR(far.delta(), 0.73, 0.02);
+}
+
+// Claim C6, Fig. 2.5d: hysteresis disappears where eq. 2.10 says, within the 0.2 um S0 grid.
+TEST(Equation210, HysteresisCutoffMatchesTheAnalyticThreshold) {
+  const SphereMaterial iron;
+  for (double k : {3e-3, 1e-2, 4e-2, 1e-1}) {
+    const double threshold = clustering_threshold_separation(iron, k);
+    EXPECT_TRUE(critical_fields_of(single_spring(k, threshold - 0.2e-6), {}).hysteresis) << k;
+    EXPECT_FALSE(critical_fields_of(single_spring(k, threshold + 0.2e-6), {}).hysteresis) << k;
+  }
+}
+
+// Fig. 2.6 / Section 2.5.3: the WCA leaves clustered pairs slightly further apart than tanh
+// (its cut-off is 2^(1/6) 2R) and so releases them at a slightly larger |H_C1|.
+TEST(Figure26, WcaGivesLargerMinimumSeparationAndLargerReleaseField) {
+  const PairSystem tanh = single_spring(4e-2, 9e-6, PenaltyKind::tanh);
+  const PairSystem wca = single_spring(4e-2, 9e-6, PenaltyKind::wca);
+  const HysteresisLoop loop_tanh = run_hysteresis(tanh, {});
+  const HysteresisLoop loop_wca = run_hysteresis(wca, {});
+  const double gap_tanh = min_displacement(loop_tanh, 9e-6);
+  const double gap_wca = min_displacement(loop_wca, 9e-6);
+  EXPECT_GT(gap_wca, gap_tanh);
+  EXPECT_LT(gap_wca - gap_tanh, 0.5e-6);  // "slightly"
+  const CriticalFields cf_tanh = find_critical_fields(tanh, loop_tanh);
+  const CriticalFields cf_wca = find_critical_fields(wca, loop_wca);
+  EXPECT_GT(cf_wca.hc1, cf_tanh.hc1);
+  EXPECT_NEAR(cf_wca.hc1, analytic_release_field(wca, 4e-2, wca.penalty.r_cut), 1e-4);
+  EXPECT_NEAR(cf_wca.hc2, cf_tanh.hc2, 1e-4);  // clustering happens far from either penalty
+}
+
+// Section 2.4: the single-spring model with k = k0/2 + k12 and the three-spring model give the
+// same loop at theta_H = 0 (same penalty).
+TEST(Figure26, ThreeSpringAtZeroAngleEqualsItsEquivalentSingleSpring) {
+  const PairSystem three = three_spring_puljiz(2130.0, 9e-6);
+  const PairSystem single =
+      single_spring(0.5 * three.springs.k0 + three.springs.k12, 9e-6, PenaltyKind::wca);
+  const HysteresisLoop a = run_hysteresis(three, {});
+  const HysteresisLoop b = run_hysteresis(single, {});
+  ASSERT_EQ(a.states.size(), b.states.size());
+  for (std::size_t i = 0; i < a.states.size(); ++i) {
+    EXPECT_NEAR(a.states[i].distance(), b.states[i].distance(), 1e-15) << i;
+    EXPECT_NEAR(a.states[i].rotation_deg(), 0.0, 1e-9);
+  }
+}
+
+// Fig. 2.7: G = 1375 Pa, S0 = 9 um, theta_H = 10 deg: hysteresis, and the pair rotates towards
+// the field but never past it.
+TEST(Figure27, TenDegreesIsHystereticAndRotatesLessThanTheField) {
+  const PairSystem p = three_spring_puljiz(1375.0, 9e-6);
+  SweepOptions sweep;
+  sweep.theta_h_deg = 10.0;
+  const HysteresisLoop loop = run_hysteresis(p, sweep);
+  EXPECT_TRUE(find_critical_fields(p, loop).hysteresis);
+  for (const PairState& s : loop.states) {
+    EXPECT_TRUE(s.converged) << s.field;
+    EXPECT_GE(s.rotation_deg(), -1e-12);
+    EXPECT_LT(s.rotation_deg(), 10.0);
+  }
+  EXPECT_GT(loop.states[100].rotation_deg(), 5.0);  // clustered at 1 T: turned well towards H
+}
+
+// Claim C8, Fig. 2.8: theta_H = 80 deg: no hysteresis, rotation "almost 3 deg" at saturation.
+TEST(Figure28, EightyDegreesIsReversibleWithAboutThreeDegreesOfRotation) {
+  const PairSystem p = three_spring_puljiz(1375.0, 9e-6);
+  SweepOptions sweep;
+  sweep.theta_h_deg = 80.0;
+  const HysteresisLoop loop = run_hysteresis(p, sweep);
+  EXPECT_FALSE(find_critical_fields(p, loop).hysteresis);
+  const double rotation_at_1t = loop.states[100].rotation_deg();
+  EXPECT_GT(rotation_at_1t, 2.0);
+  EXPECT_LT(rotation_at_1t, 3.2);
+}
+
+// Claim C9, Fig. 3.4: S0 = 12 um: k = 9e-3 N/m is hysteretic, k = 9e-1 N/m is not.
+TEST(Figure34, SoftSpringIsHystereticStiffSpringIsNot) {
+  EXPECT_TRUE(critical_fields_of(single_spring(9e-3, 12e-6), {}).hysteresis);
+  EXPECT_FALSE(critical_fields_of(single_spring(9e-1, 12e-6), {}).hysteresis);
+}
+
+// Critical fields are refined well below the sweep step: a 0.01 T sweep with refinement agrees
+// with a 0.001 T sweep with refinement.
+TEST(CriticalFields, RefinementIsIndependentOfTheSweepStep) {
+  const PairSystem p = single_spring(4e-2, 9e-6);
+  SweepOptions coarse;
+  SweepOptions fine;
+  fine.b_step = 0.001;
+  const CriticalFields a = critical_fields_of(p, coarse);
+  const CriticalFields b = critical_fields_of(p, fine);
+  EXPECT_NEAR(a.hc1, b.hc1, 1e-4);
+  EXPECT_NEAR(a.hc2, b.hc2, 1e-4);
+  EXPECT_LE(a.uncertainty, 0.5e-4);
+}
+
+}  // namespace
+}  // namespace mresim::pair
