@@ -31,6 +31,9 @@ int main(int argc, char** argv) {
       "mresim"};
   app.set_version_flag("--version", std::string("mresim ") + mresim::kVersion);
   app.require_subcommand(1);
+  app.footer(
+      "Exit status: 0 success; 1 the run failed (nothing was written); 2 invalid run file,\n"
+      "command line or --out (nothing was done); 3 results written but drawing figures failed.");
 
   RunOptions run_options;
   InfoOptions info_options;

@@ -76,6 +76,18 @@ std::string python_interpreter() {
   return from_env != nullptr && *from_env != '\0' ? from_env : "python3";
 }
 
+namespace {
+
+// Debian's interpreter, the one python3-matplotlib & co. install into.
+constexpr const char* kSystemPython = "/usr/bin/python3";
+
+bool has_plot_modules(const std::string& python) {
+  const ChildResult r = spawn_and_wait({python, "-c", "import matplotlib, numpy, h5py"}, true);
+  return r.started && r.exit_status == 0;
+}
+
+}  // namespace
+
 int draw_figures(const std::filesystem::path& run_dir) {
   const auto script = python_dir() / "mresim_plot.py";
   if (!std::filesystem::is_regular_file(script)) {
@@ -83,22 +95,28 @@ int draw_figures(const std::filesystem::path& run_dir) {
         "plot script '{}' not found; set MRESIM_PYTHON_DIR to the directory holding mresim_plot.py",
         script.string()));
   }
+  const bool user_chose_python = std::getenv("MRESIM_PYTHON") != nullptr;
   const std::string python = python_interpreter();
   const ChildResult plot = spawn_and_wait({python, script.string(), run_dir.string()}, false);
+  if (plot.started && plot.exit_status == 0) return 0;
+
+  const bool modules_found = plot.started && has_plot_modules(python);
+  if (!modules_found && !user_chose_python && python != kSystemPython &&
+      std::filesystem::exists(kSystemPython) && has_plot_modules(kSystemPython)) {
+    // A python3 earlier on PATH (pyenv, conda, a virtualenv) often lacks the Debian packages
+    // the README installs; the system interpreter has them.
+    std::fprintf(stderr, "mresim: note: %s lacks matplotlib, numpy or h5py; using %s\n",
+                 python.c_str(), kSystemPython);
+    return spawn_and_wait({kSystemPython, script.string(), run_dir.string()}, false).exit_status;
+  }
   if (!plot.started) {
     std::fprintf(stderr, "mresim: error: %s was not found; %s\n", python.c_str(), kInstallHint);
-    return plot.exit_status;
-  }
-  if (plot.exit_status != 0) {
-    // The commonest cause by far: tell the user exactly what to install.
-    const ChildResult imports =
-        spawn_and_wait({python, "-c", "import matplotlib, numpy, h5py"}, true);
-    if (imports.exit_status != 0) {
-      std::fprintf(stderr,
-                   "mresim: error: %s cannot import matplotlib, numpy and h5py; %s (or set "
-                   "MRESIM_PYTHON to a Python interpreter that has them)\n",
-                   python.c_str(), kInstallHint);
-    }
+  } else if (!modules_found) {
+    // The commonest cause of a failed plot by far: say exactly what to install.
+    std::fprintf(stderr,
+                 "mresim: error: %s cannot import matplotlib, numpy and h5py; %s (or set "
+                 "MRESIM_PYTHON to a Python interpreter that has them)\n",
+                 python.c_str(), kInstallHint);
   }
   return plot.exit_status;
 }

@@ -300,12 +300,13 @@ TEST(Cli, PlotExplainsWhatIsMissing) {
             std::string::npos)
       << no_script.err;
 
-  // No python3 on PATH, or a Python without matplotlib.
+  // A missing interpreter, or one without matplotlib.
   write_fake_plot_script(dir / "py", 0);
   const std::string py_dir = "MRESIM_PYTHON_DIR='" + (dir / "py").string() + "'";
-  const Result no_python = mresim(dir.path(), "plot run", "PATH=/nonexistent " + py_dir);
+  const Result no_python =
+      mresim(dir.path(), "plot run", "MRESIM_PYTHON=/nonexistent/python3 " + py_dir);
   EXPECT_EQ(no_python.status, 127);
-  EXPECT_NE(no_python.err.find("python3 was not found; install with: apt-get install"),
+  EXPECT_NE(no_python.err.find("/nonexistent/python3 was not found; install with: apt-get install"),
             std::string::npos)
       << no_python.err;
   write_text(dir / "fake_python", "#!/bin/sh\nexit 1\n");
@@ -318,6 +319,28 @@ TEST(Cli, PlotExplainsWhatIsMissing) {
                                    "python3-h5py (or set MRESIM_PYTHON"),
             std::string::npos)
       << no_matplotlib.err;
+}
+
+TEST(Cli, PlotFallsBackToTheSystemPythonWhenPathHasOneWithoutMatplotlib) {
+  if (std::system("/usr/bin/python3 -c 'import matplotlib, numpy, h5py' >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "/usr/bin/python3 lacks matplotlib, numpy or h5py";
+  }
+  const TempDir dir;
+  fs::create_directories(dir / "run");
+  write_text(dir / "run" / "results.h5", "");
+  write_fake_plot_script(dir / "py", 0);
+  // A python3 first on PATH that can import nothing, as a bare virtualenv would.
+  fs::create_directories(dir / "bin");
+  write_text(dir / "bin" / "python3", "#!/bin/sh\nexit 1\n");
+  fs::permissions(dir / "bin" / "python3", fs::perms::owner_all);
+  const Result r = mresim(dir.path(), "plot run",
+                          "env -u MRESIM_PYTHON PATH='" + (dir / "bin").string() +
+                              ":/usr/bin:/bin' MRESIM_PYTHON_DIR='" + (dir / "py").string() + "'");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("lacks matplotlib, numpy or h5py; using /usr/bin/python3"),
+            std::string::npos)
+      << r.err;
+  EXPECT_TRUE(fs::exists(dir / "run" / "figures" / "backend.txt"));
 }
 
 }  // namespace
