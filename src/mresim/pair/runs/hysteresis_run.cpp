@@ -1,0 +1,81 @@
+// Run type "pair_hysteresis": one or more two-dipole hysteresis loops (Figs. 2.2-2.4, 2.6-2.8,
+// 3.4, 3.13), each with its critical fields.
+#include <fmt/format.h>
+
+#include <iostream>
+#include <memory>
+
+#include "mresim/app/run_type.hpp"
+#include "mresim/pair/runs/pair_outputs.hpp"
+
+namespace mresim::pair::runs {
+namespace {
+
+class HysteresisPlan final : public app::RunPlan {
+ public:
+  explicit HysteresisPlan(const config::TableReader& root) : cases_(read_pair_cases(root)) {}
+
+  void describe(app::InfoReport& report) const override {
+    report.add_integer("run", "cases", static_cast<std::int64_t>(cases_.size()));
+    for (std::size_t i = 0; i < cases_.size(); ++i) {
+      describe_pair(report, section(i), cases_[i]);
+    }
+  }
+
+  void execute(const std::filesystem::path& staging_dir, io::Hdf5File& results,
+               app::Progress& progress) const override {
+    std::size_t total = 0;
+    for (const PairSetup& c : cases_) total += sweep_points(c.sweep).size();
+    progress.set_total(total);
+    std::vector<HysteresisLoop> loops(cases_.size());
+    std::vector<CriticalFields> fields(cases_.size());
+    const auto count = static_cast<long>(cases_.size());
+#pragma omp parallel for schedule(dynamic, 1)
+    for (long i = 0; i < count; ++i) {
+      const auto c = static_cast<std::size_t>(i);
+      const PairSystem system = cases_[c].system();
+      loops[c] = run_hysteresis(system, cases_[c].sweep);
+      CriticalFieldOptions options;
+      options.tolerance = cases_[c].critical_field_tolerance;
+      fields[c] = find_critical_fields(system, loops[c], options);
+      progress.advance(loops[c].states.size());
+    }
+
+    io::CsvWriter summary(staging_dir / "summary.csv", loop_csv_columns());
+    io::CsvWriter critical(staging_dir / "critical_fields.csv",
+                           {"case", "label", "hysteresis", "HC1_T", "HC2_T", "dH_T",
+                            "uncertainty_T"});
+    for (std::size_t c = 0; c < cases_.size(); ++c) {
+      const std::string group = fmt::format("/cases/{}", c);
+      append_loop_rows(summary, c, cases_[c], loops[c]);
+      write_loop_hdf5(results, group, cases_[c], cases_[c].system(), loops[c]);
+      write_critical_fields_hdf5(results, group + "/critical_fields", fields[c]);
+      critical.row_cells({static_cast<double>(c), cases_[c].label,
+                          fields[c].hysteresis ? 1.0 : 0.0, fields[c].hc1, fields[c].hc2,
+                          fields[c].delta(), fields[c].uncertainty});
+      if (const std::size_t bad = unconverged_states(loops[c]); bad > 0) {
+        std::cerr << fmt::format("mresim: warning: case {} ({}): {} of {} states did not reach "
+                                 "the relaxation tolerance (see solver/converged)\n",
+                                 c, cases_[c].label, bad, loops[c].states.size());
+      }
+    }
+    results.write_int_attribute("/cases", "count", static_cast<std::int64_t>(cases_.size()));
+  }
+
+ private:
+  std::string section(std::size_t i) const {
+    return cases_.size() == 1 ? std::string("pair") : fmt::format("case {}: {}", i, cases_[i].label);
+  }
+
+  std::vector<PairSetup> cases_;
+};
+
+const app::RunTypeRegistrar registrar({"pair_hysteresis",
+                                       "Two-dipole hysteresis loops with critical fields "
+                                       "(Chapters 2-3)",
+                                       [](const config::TableReader& root) {
+                                         return std::make_unique<HysteresisPlan>(root);
+                                       }});
+
+}  // namespace
+}  // namespace mresim::pair::runs
