@@ -161,7 +161,8 @@ void read_field(const TableReader& t, SweepOptions& sweep) {
 
 }  // namespace
 
-PairSetup read_pair_setup(const TableReader& scope, const PairSetup& base, bool is_root) {
+PairSetup read_pair_setup(const TableReader& scope, const PairSetup& base, bool is_root,
+                          bool stiffness_required) {
   PairSetup s = base;
   if (auto t = scope.optional_table("material")) read_material(*t, s.material);
 
@@ -177,7 +178,7 @@ PairSetup read_pair_setup(const TableReader& scope, const PairSetup& base, bool 
     s.rest_separation = springs->number_or("rest_separation", s.rest_separation,
                                            Range::positive(), "m");
     const bool given = read_stiffness(*springs, s.model, s.stiffness);
-    if (!given && (is_root || model_changed)) {
+    if (!given && stiffness_required && (is_root || model_changed)) {
       springs->fail("model", model,
                     "needs a stiffness: k (single), k0 and k12 (three), shear_modulus, or "
                     "youngs_modulus (single)");
@@ -201,6 +202,15 @@ PairSetup read_pair_setup(const TableReader& scope, const PairSetup& base, bool 
   }
   validate_pair(scope, s);
   return s;
+}
+
+void require_separable(const TableReader& table, const std::string& key, double s0,
+                       const SphereMaterial& material) {
+  if (s0 <= 2.0 * material.radius) {
+    table.fail(key, s0,
+               fmt::format("every separation must be > 2R = {:.6g} m (the spheres would overlap)",
+                           2.0 * material.radius));
+  }
 }
 
 void validate_pair(const TableReader& scope, const PairSetup& s) {

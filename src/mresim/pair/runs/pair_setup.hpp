@@ -42,11 +42,17 @@ struct PairSetup {
 
 // Reads the setup from `scope` (the root, or one [[case]] table), every key falling back to
 // `base`. At the root, [springs] is required; in a case every table is optional.
-PairSetup read_pair_setup(const config::TableReader& scope, const PairSetup& base, bool is_root);
+// `stiffness_required` is false for maps whose rows set k themselves.
+PairSetup read_pair_setup(const config::TableReader& scope, const PairSetup& base, bool is_root,
+                          bool stiffness_required = true);
 
 // The root setup plus one setup per [[case]] (label required there); if there are no cases,
 // the root setup alone, labelled with [run].title.
 std::vector<PairSetup> read_pair_cases(const config::TableReader& root);
+
+// Checks a separation S0 > 2R for a value coming from elsewhere (map axes, ensembles).
+void require_separable(const config::TableReader& table, const std::string& key, double s0,
+                       const SphereMaterial& material);
 
 // Validation of the assembled pair (S0 > 2R, WCA r_cut > r_min, ...), naming the key at fault.
 void validate_pair(const config::TableReader& scope, const PairSetup& setup);

@@ -1,0 +1,136 @@
+// Run type "pair_map": critical fields H_C1, H_C2 and dH over a grid of (k, S0) for the
+// single-spring model (Fig. 2.5) or (theta_H, S0) (Fig. 2.9, three-spring with Puljiz springs),
+// with the eq. 2.10 threshold alongside for k maps.
+#include <fmt/format.h>
+
+#include <memory>
+
+#include "mresim/app/run_type.hpp"
+#include "mresim/pair/parameter_map.hpp"
+#include "mresim/pair/runs/grid_axis.hpp"
+#include "mresim/pair/runs/pair_outputs.hpp"
+#include "mresim/pair/stiffness.hpp"
+
+namespace mresim::pair::runs {
+namespace {
+
+using config::Range;
+
+class MapPlan final : public app::RunPlan {
+ public:
+  explicit MapPlan(const config::TableReader& root) {
+    const config::TableReader map = root.table("map");
+    row_parameter_ = map.choice("rows", {"k", "angle"});
+    base_ = read_pair_setup(root, PairSetup{}, true, row_parameter_ != "k");
+    if (row_parameter_ == "k") {
+      if (base_.model != SpringModel::single) {
+        map.fail("rows", "\"k\"", "k rows need springs.model = \"single\" (Fig. 2.5)");
+      }
+      rows_ = read_grid_axis(map, "row", Range::positive(), "N/m", "log");
+    } else {
+      rows_ = read_grid_axis(map, "row", Range::between(0.0, 90.0), "deg", "linear");
+    }
+    separations_ = read_grid_axis(map, "separation", Range::positive(), "m", "linear");
+    for (double s0 : separations_) require_separable(map, "separation_min", s0, base_.material);
+  }
+
+  void describe(app::InfoReport& report) const override {
+    describe_pair(report, "base pair", base_);
+    report.add_text("map", "rows", row_parameter_ == "k" ? "k (N/m)" : "field angle theta_H (deg)");
+    report.add_integer("map", "row_count", static_cast<std::int64_t>(rows_.size()));
+    report.add("map", "row_first", rows_.front(), row_parameter_ == "k" ? "N/m" : "deg");
+    report.add("map", "row_last", rows_.back(), row_parameter_ == "k" ? "N/m" : "deg");
+    report.add_integer("map", "separation_count", static_cast<std::int64_t>(separations_.size()));
+    report.add("map", "separation_first", separations_.front(), "m");
+    report.add("map", "separation_last", separations_.back(), "m");
+    report.add_integer("map", "points", static_cast<std::int64_t>(rows_.size() * separations_.size()));
+    SweepOptions quadrant = base_.sweep;
+    quadrant.first_quadrant_only = true;
+    report.add_integer("map", "steps_per_point", static_cast<std::int64_t>(sweep_points(quadrant).size()),
+                       "", "first quadrant 0 -> +max -> 0; the loop is odd in B");
+    if (row_parameter_ == "k") {
+      for (std::size_t i = 0; i < rows_.size(); ++i) {
+        report.add("eq. 2.10 threshold", fmt::format("S0_max(k = {:.4g} N/m)", rows_[i]),
+                   clustering_threshold_separation(base_.material, rows_[i]), "m");
+      }
+    }
+  }
+
+  void execute(const std::filesystem::path& staging_dir, io::Hdf5File& results,
+               app::Progress& progress) const override {
+    progress.set_total(rows_.size() * separations_.size());
+    CriticalFieldOptions options;
+    options.tolerance = base_.critical_field_tolerance;
+    const CriticalFieldGrid grid = map_critical_fields(
+        rows_.size(), separations_.size(), [this](std::size_t r, std::size_t c) { return point(r, c); },
+        options, [&progress] { progress.advance(); });
+    write(staging_dir, results, grid);
+  }
+
+ private:
+  MapPointSetup point(std::size_t row, std::size_t col) const {
+    PairSetup s = base_;
+    if (row_parameter_ == "k") {
+      s.stiffness.kind = StiffnessSource::Kind::spring_constant;
+      s.stiffness.k = rows_[row];
+    } else {
+      s.sweep.theta_h_deg = rows_[row];
+    }
+    return {s.system_at(separations_[col]), s.sweep};
+  }
+
+  void write(const std::filesystem::path& dir, io::Hdf5File& h5,
+             const CriticalFieldGrid& grid) const {
+    const std::size_t rows = rows_.size(), cols = separations_.size();
+    io::CsvWriter csv(dir / "summary.csv", {"row", "col", "row_value", "S0_m", "hysteresis",
+                                            "HC1_T", "HC2_T", "dH_T", "k12_N_per_m",
+                                            "k0_N_per_m"});
+    std::vector<double> hc1, hc2, dh;
+    std::vector<std::int64_t> hysteresis;
+    for (std::size_t r = 0; r < rows; ++r) {
+      for (std::size_t c = 0; c < cols; ++c) {
+        const CriticalFields& f = grid.at(r, c);
+        const PairSystem p = point(r, c).system;
+        csv.row({static_cast<double>(r), static_cast<double>(c), rows_[r], separations_[c],
+                 f.hysteresis ? 1.0 : 0.0, f.hc1, f.hc2, f.delta(), p.springs.k12, p.springs.k0});
+        hc1.push_back(f.hc1);
+        hc2.push_back(f.hc2);
+        dh.push_back(f.delta());
+        hysteresis.push_back(f.hysteresis ? 1 : 0);
+      }
+    }
+    h5.write_string_attribute("/map", "row_parameter", row_parameter_);
+    h5.write_number_attribute("/map", "critical_field_uncertainty_T", 0.5 * base_.critical_field_tolerance);
+    h5.write_vector("/map/row_values", rows_, row_parameter_ == "k" ? "N/m" : "deg");
+    h5.write_vector("/map/separations", separations_, "m");
+    h5.write_matrix("/map/HC1", rows, cols, hc1, "T");
+    h5.write_matrix("/map/HC2", rows, cols, hc2, "T");
+    h5.write_matrix("/map/dH", rows, cols, dh, "T");
+    std::vector<double> as_double(hysteresis.begin(), hysteresis.end());
+    h5.write_array("/map/hysteresis", {rows, cols}, as_double, "1");
+    if (row_parameter_ == "k") {
+      io::CsvWriter threshold(dir / "threshold.csv", {"k_N_per_m", "S0_threshold_m"});
+      std::vector<double> s0_max;
+      for (double k : rows_) {
+        s0_max.push_back(clustering_threshold_separation(base_.material, k));
+        threshold.row({k, s0_max.back()});
+      }
+      h5.write_vector("/map/eq_2_10_threshold", s0_max, "m");
+    }
+  }
+
+  std::string row_parameter_;
+  PairSetup base_;
+  std::vector<double> rows_;
+  std::vector<double> separations_;
+};
+
+const app::RunTypeRegistrar registrar({"pair_map",
+                                       "Critical-field maps over (k, S0) or (theta_H, S0) "
+                                       "(Figs. 2.5, 2.9)",
+                                       [](const config::TableReader& root) {
+                                         return std::make_unique<MapPlan>(root);
+                                       }});
+
+}  // namespace
+}  // namespace mresim::pair::runs
