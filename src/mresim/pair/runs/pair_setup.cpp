@@ -179,7 +179,7 @@ PairSetup read_pair_setup(const TableReader& scope, const PairSetup& base, bool 
                                            Range::positive(), "m");
     const bool given = read_stiffness(*springs, s.model, s.stiffness);
     if (!given && stiffness_required && (is_root || model_changed)) {
-      springs->fail("model", model,
+      springs->fail("model", springs->value_text("model").empty() ? "\"" + model + "\"" : springs->value_text("model"),
                     "needs a stiffness: k (single), k0 and k12 (three), shear_modulus, or "
                     "youngs_modulus (single)");
     }
