@@ -6,7 +6,12 @@
 
 namespace mresim::pair {
 
+// Newton (default, fast) or the nonlinear conjugate gradients the dissertation used
+// (Section 2.4), kept as a reference to measure against (bench/pair_bench.cpp).
+enum class RelaxMethod { newton, conjugate_gradient };
+
 struct RelaxOptions {
+  RelaxMethod method = RelaxMethod::newton;
   double gradient_tolerance = 1e-12;  // on |dE/dd| in units of mu0 Ms^2 V / R
   int max_iterations = 2000;
   double max_step = 0.25;             // largest move per iteration, in units of R
@@ -30,5 +35,11 @@ struct RelaxResult {
 // gradients; Newton reaches the same local minimum in a handful of iterations.)
 RelaxResult relax(const PairEnergy& energy, SpringModel model, const Eigen::Vector3d& start,
                   const RelaxOptions& options = {});
+
+// Polak-Ribiere+ nonlinear conjugate gradients with a bracketing line search on the directional
+// derivative, in the same coordinates and with the same energy. (N = 1: S; N = 2: S, theta.)
+template <int N>
+RelaxResult relax_conjugate_gradient(const PairEnergy& energy, const Eigen::Vector3d& start_scaled,
+                                     const RelaxOptions& options);
 
 }  // namespace mresim::pair

@@ -153,6 +153,10 @@ void describe_pair(app::InfoReport& report, const std::string& section, const Pa
   report.add_integer(section, "steps_per_loop",
                      static_cast<std::int64_t>(sweep_points(sw).size()));
   report.add(section, "critical_field_tolerance", setup.critical_field_tolerance, "T");
+  report.add_text(section, "relaxation",
+                  sw.relax.method == RelaxMethod::newton
+                      ? "Newton (polar coordinates, exact gradient)"
+                      : "nonlinear conjugate gradients (Section 2.4, reference)");
 }
 
 std::size_t unconverged_states(const HysteresisLoop& loop) {

@@ -192,6 +192,15 @@ PairSetup read_pair_setup(const TableReader& scope, const PairSetup& base, bool 
   }
   if (auto t = scope.optional_table("penalty")) read_penalty(*t, s);
   if (auto t = scope.optional_table("field")) read_field(*t, s.sweep);
+  if (auto t = scope.optional_table("solver")) {
+    const std::string current =
+        s.sweep.relax.method == RelaxMethod::newton ? "newton" : "conjugate_gradient";
+    const std::string method = t->choice_or("method", current, {"newton", "conjugate_gradient"});
+    s.sweep.relax.method =
+        method == "newton" ? RelaxMethod::newton : RelaxMethod::conjugate_gradient;
+    s.sweep.relax.max_iterations = static_cast<int>(
+        t->integer_or("max_iterations", s.sweep.relax.max_iterations, Range::between(1, 10000000)));
+  }
   if (auto t = scope.optional_table("critical_fields")) {
     s.critical_field_tolerance = t->number_or("tolerance", s.critical_field_tolerance,
                                               Range::positive(), "T");
