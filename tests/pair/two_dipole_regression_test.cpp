@@ -213,3 +213,38 @@ TEST(Figure29, AngleRangeOfClusteringShrinksWithSeparation) {
 
 }  // namespace
 }  // namespace mresim::pair
+
+namespace mresim::pair {
+namespace {
+
+// At small S0 the bistable range is narrower than the 0.01 T sweep step and can fall between
+// two grid fields; the jump of the rising branch must still reveal it, with the same critical
+// fields as a sweep fine enough to step into the range.
+TEST(CriticalFields, FindsABistableRangeNarrowerThanTheSweepStep) {
+  PairSystem p;
+  p.springs = {SpringModel::single, 1e-3, 0.0, 4.0e-6};
+  SweepOptions coarse;
+  SweepOptions fine;
+  fine.b_step = 1e-4;
+  fine.b_max = 0.2;
+  const CriticalFields a = critical_fields_of(p, coarse);
+  CriticalFieldOptions fine_options;
+  fine_options.tolerance = 1e-5;
+  const CriticalFields b = critical_fields_of(p, fine, fine_options);
+  ASSERT_TRUE(b.hysteresis);
+  ASSERT_LT(b.delta(), 0.01);  // narrower than the coarse step
+  ASSERT_TRUE(a.hysteresis);
+  EXPECT_NEAR(a.hc1, b.hc1, 1e-4);
+  EXPECT_NEAR(a.hc2, b.hc2, 1e-4);
+}
+
+// Eq. 2.10's saturated fold lies at S = 0.8 S0; below S0 = 2.5 R it would be inside contact, so
+// small separations close continuously into contact without hysteresis.
+TEST(CriticalFields, NoHysteresisWhenTheFoldWouldLieInsideContact) {
+  PairSystem p;
+  p.springs = {SpringModel::single, 1e-2, 0.0, 3.4e-6};
+  EXPECT_FALSE(critical_fields_of(p, {}).hysteresis);
+}
+
+}  // namespace
+}  // namespace mresim::pair

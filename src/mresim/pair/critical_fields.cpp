@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <map>
+#include <optional>
+#include <utility>
 
 namespace mresim::pair {
 namespace {
@@ -32,6 +34,35 @@ double refine(const PairSystem& system, Bracket b, const Eigen::Vector3d& direct
   return 0.5 * (b.single_field + b.bistable_field);
 }
 
+// A bistable range narrower than the sweep step can fall between two grid fields: the rising
+// branch then jumps between b_lo and b_hi with no grid field holding two states. Bisect the
+// step: at a trial field relax from both ends' states; if they differ the field is bistable
+// (returned as a bracket for both ends), otherwise the single state tells which half the jump
+// lies in. Returns nothing if the step holds only a steep but continuous change.
+std::optional<std::pair<Bracket, Bracket>> bistable_inside_step(
+    const PairSystem& system, double b_lo, Eigen::Vector3d before, double b_hi,
+    Eigen::Vector3d after, const Eigen::Vector3d& direction, const SweepOptions& sweep,
+    const CriticalFieldOptions& opt) {
+  const double distinct = opt.distinct_states * system.material.radius;
+  while (b_hi - b_lo > opt.tolerance) {
+    const double mid = 0.5 * (b_lo + b_hi);
+    const PairState a = relax_at_field(system, mid, direction, before, sweep.relax);
+    const PairState c = relax_at_field(system, mid, direction, after, sweep.relax);
+    if ((a.separation - c.separation).norm() > distinct) {
+      return std::pair{Bracket{mid, a.separation, c.separation, b_hi},
+                       Bracket{mid, a.separation, c.separation, b_lo}};
+    }
+    if ((a.separation - before).norm() < (a.separation - after).norm()) {
+      b_lo = mid;
+      before = a.separation;
+    } else {
+      b_hi = mid;
+      after = a.separation;
+    }
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 CriticalFields find_critical_fields(const PairSystem& system, const HysteresisLoop& loop,
@@ -47,6 +78,9 @@ CriticalFields find_critical_fields(const PairSystem& system, const HysteresisLo
     if (s.branch == 1) falling[j] = &s;
   }
   const double distinct = options.distinct_states * system.material.radius;
+  // Steps of the rising branch that move the pair by more than this (in R) are checked for a
+  // bistable range narrower than the step.
+  constexpr double kJumpFraction = 1e-2;
   int first = -1, last = -1;
   for (const auto& [j, up] : rising) {
     auto down = falling.find(j);
@@ -57,9 +91,27 @@ CriticalFields find_critical_fields(const PairSystem& system, const HysteresisLo
     }
   }
   CriticalFields result;
-  if (first < 0) return result;
-  result.hysteresis = true;
   const Eigen::Vector3d direction = field_direction(sweep.theta_h_deg);
+  if (first < 0) {
+    // No grid field is bistable; look for a jump of the rising branch that hides a narrow
+    // bistable range (small S0, where dH is below the sweep step).
+    const double jump = kJumpFraction * system.material.radius;
+    for (auto it = rising.begin(); std::next(it) != rising.end(); ++it) {
+      const PairState& lo = *it->second;
+      const PairState& hi = *std::next(it)->second;
+      if ((hi.separation - lo.separation).norm() <= jump) continue;
+      const auto found = bistable_inside_step(system, lo.field, lo.separation, hi.field,
+                                              hi.separation, direction, sweep, options);
+      if (!found) continue;
+      result.hysteresis = true;
+      result.hc2 = refine(system, found->first, direction, sweep, options);
+      result.hc1 = refine(system, found->second, direction, sweep, options);
+      result.uncertainty = 0.5 * options.tolerance;
+      return result;
+    }
+    return result;
+  }
+  result.hysteresis = true;
   auto bracket_at = [&](int j, int neighbour) {
     return Bracket{j * step, rising.at(j)->separation, falling.at(j)->separation,
                    neighbour * step};
