@@ -122,10 +122,11 @@ class RatioReporter : public benchmark::ConsoleReporter {
     const auto one = seconds_.find("BM_Fig25Map/0/1/iterations:1/real_time");
     const auto two = seconds_.find("BM_Fig25Map/0/2/iterations:1/real_time");
     if (one != seconds_.end() && two != seconds_.end()) {
-      std::printf("  map, Newton: 1 thread %.3f s, 2 threads %.3f s (speed-up %.2fx); target for "
-                  "the whole map on 2 cores: < 1.5 s -> %s\n",
-                  one->second, two->second, one->second / two->second,
-                  two->second < 1.5 ? "met" : "NOT met");
+      std::printf(
+          "  map, Newton: 1 thread %.3f s, 2 threads %.3f s (speed-up %.2fx); target for "
+          "the whole map on 2 cores: < 1.5 s -> %s\n",
+          one->second, two->second, one->second / two->second,
+          two->second < 1.5 ? "met" : "NOT met");
     }
     for (const auto& [name, metres] : g_agreement) {
       std::printf("  agreement %-40s max |d_newton - d_cg| = %.3g m\n", name.c_str(), metres);

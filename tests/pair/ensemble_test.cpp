@@ -1,10 +1,10 @@
 #include "mresim/pair/ensemble.hpp"
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <numeric>
-#include <omp.h>
 
 #include "mresim/pair/parameter_map.hpp"
 
@@ -74,9 +74,9 @@ TEST(LoopWidening, IsZeroForAReversibleLoop) {
 TEST(FivePointAverage, ShrinksTheWindowAtTheEnds) {
   const std::vector<double> v{1, 2, 3, 4, 5, 6};
   const std::vector<double> a = five_point_average(v);
-  EXPECT_DOUBLE_EQ(a[0], 2.0);   // (1+2+3)/3
-  EXPECT_DOUBLE_EQ(a[2], 3.0);   // (1..5)/5
-  EXPECT_DOUBLE_EQ(a[5], 5.0);   // (4+5+6)/3
+  EXPECT_DOUBLE_EQ(a[0], 2.0);  // (1+2+3)/3
+  EXPECT_DOUBLE_EQ(a[2], 3.0);  // (1..5)/5
+  EXPECT_DOUBLE_EQ(a[5], 5.0);  // (4+5+6)/3
 }
 
 // Results must not depend on the number of threads.

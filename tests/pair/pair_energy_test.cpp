@@ -94,9 +94,9 @@ TEST(OverlapPenalty, DerivativesMatchFiniteDifferences) {
     const PenaltyValue v = overlap_penalty(p, r, s);
     const double d1 =
         (overlap_penalty(p, r, s + h).energy - overlap_penalty(p, r, s - h).energy) / (2 * h);
-    const double d2 = (overlap_penalty(p, r, s + h).derivative -
-                       overlap_penalty(p, r, s - h).derivative) /
-                      (2 * h);
+    const double d2 =
+        (overlap_penalty(p, r, s + h).derivative - overlap_penalty(p, r, s - h).derivative) /
+        (2 * h);
     EXPECT_NEAR(v.derivative, d1, 1e-6 * std::abs(v.derivative));
     EXPECT_NEAR(v.second_derivative, d2, 1e-5 * std::abs(v.second_derivative));
   }

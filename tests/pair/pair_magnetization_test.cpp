@@ -71,8 +71,8 @@ TEST(PairMagnetization, AxialAndTransverseResponsesFollowTheCouplingEigenvalues)
   const double h = 0.05;
   const auto axial = solve_pair_magnetization({s, 0, 0}, {h, 0, 0}, 2.0);
   const auto transverse = solve_pair_magnetization({s, 0, 0}, {0, 0, h}, 2.0);
-  EXPECT_NEAR(axial.m.x(), h / (0.5 - 2.0 * a), 1e-15);     // enhanced along the axis
-  EXPECT_NEAR(transverse.m.z(), h / (0.5 + a), 1e-15);      // reduced across it
+  EXPECT_NEAR(axial.m.x(), h / (0.5 - 2.0 * a), 1e-15);  // enhanced along the axis
+  EXPECT_NEAR(transverse.m.z(), h / (0.5 + a), 1e-15);   // reduced across it
 }
 
 }  // namespace

@@ -61,7 +61,8 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadInput{"NegativeStiffness", with("k = 4e-2", "k = -4e-2"),
                  "springs.k = -0.04: must be > 0 (N/m)"},
-        BadInput{"SeparationInsideContact", with("rest_separation = 9e-6", "rest_separation = 3e-6"),
+        BadInput{"SeparationInsideContact",
+                 with("rest_separation = 9e-6", "rest_separation = 3e-6"),
                  "springs.rest_separation = 3e-06: must be > 2R = 3e-06 m (the spheres would "
                  "overlap)"},
         BadInput{"NonPositiveSusceptibility", kValid + "[material]\nsusceptibility = 0\n",

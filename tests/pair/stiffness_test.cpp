@@ -26,15 +26,15 @@ TEST(PuljizStiffness, EquivalentSingleSpringOfFigure26) {
 TEST(YoungsModulusConversion, ChapterThreeCylinder) {
   EXPECT_NEAR(youngs_from_spring_chapter3(9e-3, 1.5e-6, 12e-6), 7.64e3, 0.01e3);
   EXPECT_NEAR(youngs_from_spring_chapter3(9e-1, 1.5e-6, 12e-6), 764e3, 1e3);
-  EXPECT_NEAR(spring_from_youngs_chapter3(youngs_from_spring_chapter3(0.3, 1.5e-6, 7e-6), 1.5e-6,
-                                          7e-6),
-              0.3, 1e-15);
+  EXPECT_NEAR(
+      spring_from_youngs_chapter3(youngs_from_spring_chapter3(0.3, 1.5e-6, 7e-6), 1.5e-6, 7e-6),
+      0.3, 1e-15);
 }
 
 // Section 2.4: k = E pi R^2 / S0; the Chapter 2 cylinder gives twice the Chapter 3 modulus.
 TEST(YoungsModulusConversion, ChapterTwoCylinder) {
-  EXPECT_NEAR(spring_from_youngs_chapter2(1e4, 1.5e-6, 9e-6), 1e4 * 3.141592653589793 * 2.25e-12 / 9e-6,
-              1e-15);
+  EXPECT_NEAR(spring_from_youngs_chapter2(1e4, 1.5e-6, 9e-6),
+              1e4 * 3.141592653589793 * 2.25e-12 / 9e-6, 1e-15);
   EXPECT_NEAR(youngs_from_spring_chapter2(9e-3, 1.5e-6, 12e-6),
               2.0 * youngs_from_spring_chapter3(9e-3, 1.5e-6, 12e-6), 1e-9);
 }

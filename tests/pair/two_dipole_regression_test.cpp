@@ -62,7 +62,8 @@ TEST(Figure22, AxialFieldClustersToSurfaceContactWithABistableRange) {
   // Pinched loop: below H_C1 both branches coincide (no remanence).
   for (const PairState& s : loop.states) {
     if (std::abs(s.field) < cf.hc1 - 0.01 && s.branch == 1) {
-      const PairState& first = loop.states[static_cast<std::size_t>(std::lround(std::abs(s.field) / 0.01))];
+      const PairState& first =
+          loop.states[static_cast<std::size_t>(std::lround(std::abs(s.field) / 0.01))];
       EXPECT_NEAR(s.distance(), first.distance(), 1e-12) << s.field;
     }
   }
@@ -204,8 +205,8 @@ bool three_spring_hysteresis(double s0, double angle) {
 // our map still finds clustering at 20 deg there and none from 25 deg, one 5-deg map step more
 // than the text reads off its Fig. 2.9).
 TEST(Figure29, AngleRangeOfClusteringShrinksWithSeparation) {
-  EXPECT_TRUE(three_spring_hysteresis(6.2e-6, 85.0));   // S0 < 4.4 R = 6.6 um
-  EXPECT_TRUE(three_spring_hysteresis(8.8e-6, 50.0));   // S0 < 6 R
+  EXPECT_TRUE(three_spring_hysteresis(6.2e-6, 85.0));  // S0 < 4.4 R = 6.6 um
+  EXPECT_TRUE(three_spring_hysteresis(8.8e-6, 50.0));  // S0 < 6 R
   EXPECT_TRUE(three_spring_hysteresis(10e-6, 10.0));
   EXPECT_FALSE(three_spring_hysteresis(10e-6, 30.0));
   EXPECT_FALSE(three_spring_hysteresis(10e-6, 50.0));

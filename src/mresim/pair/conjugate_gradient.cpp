@@ -62,8 +62,8 @@ RelaxResult relax_conjugate_gradient(const PairEnergy& energy, const Eigen::Vect
     double alpha = hi;
     for (int refine = 0; refine < 60 && (slope_hi > 0.0 || e_trial > e); ++refine) {
       // Secant estimate of phi' = 0, kept inside the bracket; bisection if it strays.
-      double trial = slope_hi > 0.0 ? lo - slope_lo * (hi - lo) / (slope_hi - slope_lo)
-                                    : 0.5 * (lo + hi);
+      double trial =
+          slope_hi > 0.0 ? lo - slope_lo * (hi - lo) / (slope_hi - slope_lo) : 0.5 * (lo + hi);
       if (!(trial > lo && trial < hi) || e_trial > e) trial = 0.5 * (lo + hi);
       alpha = trial;
       e_trial = evaluate(q + alpha * direction, g_trial);

@@ -39,10 +39,12 @@ double refine(const PairSystem& system, Bracket b, const Eigen::Vector3d& direct
 // step: at a trial field relax from both ends' states; if they differ the field is bistable
 // (returned as a bracket for both ends), otherwise the single state tells which half the jump
 // lies in. Returns nothing if the step holds only a steep but continuous change.
-std::optional<std::pair<Bracket, Bracket>> bistable_inside_step(
-    const PairSystem& system, double b_lo, Eigen::Vector3d before, double b_hi,
-    Eigen::Vector3d after, const Eigen::Vector3d& direction, const SweepOptions& sweep,
-    const CriticalFieldOptions& opt) {
+std::optional<std::pair<Bracket, Bracket>> bistable_inside_step(const PairSystem& system,
+                                                                double b_lo, Eigen::Vector3d before,
+                                                                double b_hi, Eigen::Vector3d after,
+                                                                const Eigen::Vector3d& direction,
+                                                                const SweepOptions& sweep,
+                                                                const CriticalFieldOptions& opt) {
   const double distinct = opt.distinct_states * system.material.radius;
   while (b_hi - b_lo > opt.tolerance) {
     const double mid = 0.5 * (b_lo + b_hi);
@@ -113,8 +115,7 @@ CriticalFields find_critical_fields(const PairSystem& system, const HysteresisLo
   }
   result.hysteresis = true;
   auto bracket_at = [&](int j, int neighbour) {
-    return Bracket{j * step, rising.at(j)->separation, falling.at(j)->separation,
-                   neighbour * step};
+    return Bracket{j * step, rising.at(j)->separation, falling.at(j)->separation, neighbour * step};
   };
   result.hc2 = refine(system, bracket_at(last, last + 1), direction, sweep, options);
   result.hc1 = refine(system, bracket_at(first, first - 1), direction, sweep, options);

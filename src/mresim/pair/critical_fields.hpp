@@ -17,8 +17,8 @@ struct CriticalFields {
 };
 
 struct CriticalFieldOptions {
-  double tolerance = 1e-4;             // T, width of the final bracket
-  double distinct_states = 1e-3;       // two relaxed states differ if |d_a - d_b| > this * R
+  double tolerance = 1e-4;        // T, width of the final bracket
+  double distinct_states = 1e-3;  // two relaxed states differ if |d_a - d_b| > this * R
 };
 
 // Finds the bistable range from a sweep's first quadrant (rising branch 0, falling branch 1)

@@ -62,8 +62,8 @@ LoopWidening loop_widening(const MagnetizationLoop& loop) {
   auto key = [&](double b) { return std::lround(b / step); };
   for (std::size_t i = 0; i < loop.field.size(); ++i) {
     // The descent starts at the turning point +B_max, stored as the last point of branch 0.
-    const bool turning_point = i + 1 < loop.field.size() && loop.branch[i] == 0 &&
-                               loop.branch[i + 1] == 1;
+    const bool turning_point =
+        i + 1 < loop.field.size() && loop.branch[i] == 0 && loop.branch[i + 1] == 1;
     if ((loop.branch[i] == 1 || turning_point) && loop.field[i] >= 0.0) {
       descending[key(loop.field[i])] = loop.magnetization[i];
     }

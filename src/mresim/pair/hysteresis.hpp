@@ -28,16 +28,16 @@ std::vector<SweepPoint> sweep_points(const SweepOptions& options);
 
 // One relaxed configuration.
 struct PairState {
-  double field = 0.0;            // T, signed value of B = mu0 H along the field direction
+  double field = 0.0;  // T, signed value of B = mu0 H along the field direction
   int branch = 0;
-  Eigen::Vector3d separation;    // d = r1 - r2, m
+  Eigen::Vector3d separation;  // d = r1 - r2, m
   PairMagnetization magnetization;
   EnergyBreakdown energy;
   int iterations = 0;
   bool converged = false;
 
   double distance() const { return separation.norm(); }
-  double rotation_deg() const;   // angle of d from the x-axis in the xz-plane (Fig. 2.1b)
+  double rotation_deg() const;  // angle of d from the x-axis in the xz-plane (Fig. 2.1b)
   double magnetization_along(const Eigen::Vector3d& direction) const;  // M/Ms of the pair
 };
 

@@ -77,9 +77,9 @@ Eigen::Matrix3d PairEnergy::scaled_hessian(const Eigen::Vector3d& d) const {
     Eigen::Vector3d dp = d, dm = d;
     dp(i) += kStep;
     dm(i) -= kStep;
-    h.col(i) = (magnetic_gradient(dp, magnetization(dp).m) -
-                magnetic_gradient(dm, magnetization(dm).m)) /
-               (2.0 * kStep);
+    h.col(i) =
+        (magnetic_gradient(dp, magnetization(dp).m) - magnetic_gradient(dm, magnetization(dm).m)) /
+        (2.0 * kStep);
   }
   h = 0.5 * (h + h.transpose()).eval();
   // Radial terms f(|d|): Hessian f'' n n^T + (f'/S)(I - n n^T).

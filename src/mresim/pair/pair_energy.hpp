@@ -58,9 +58,9 @@ class PairEnergy {
   Eigen::Vector3d reduced_field_;
   double radius_;
   double energy_scale_;
-  double k12_;          // scaled spring constants k R^2 / (mu0 Ms^2 V)
+  double k12_;  // scaled spring constants k R^2 / (mu0 Ms^2 V)
   double k0_;
-  double rest_;         // S0 / R
+  double rest_;  // S0 / R
 };
 
 }  // namespace mresim::pair

@@ -65,8 +65,7 @@ PairMagnetization solve_pair_magnetization(const Eigen::Vector3d& d_over_r,
   const double h_n = reduced_field.dot(n);
   const Eigen::Vector3d h_perp_vec = reduced_field - h_n * n;
   const double h_p = h_perp_vec.norm();
-  const Eigen::Vector3d p =
-      h_p > 0.0 ? Eigen::Vector3d(h_perp_vec / h_p) : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d p = h_p > 0.0 ? Eigen::Vector3d(h_perp_vec / h_p) : Eigen::Vector3d::Zero();
 
   // Eigen-decomposition of (I/chi - D): 1/chi - 2a along n, 1/chi + a across it.
   const double inv_chi = 1.0 / susceptibility;

@@ -11,11 +11,11 @@ namespace mresim::pair {
 
 // Material of the spheres (Section 2.4 defaults: carbonyl iron, R = 1.5 um).
 struct SphereMaterial {
-  double radius = 1.5e-6;                    // m
-  double saturation_magnetization = 1.4e6;   // A/m
-  double susceptibility = 2.0;               // chi of eq. 2.1 (linear, saturable)
+  double radius = 1.5e-6;                   // m
+  double saturation_magnetization = 1.4e6;  // A/m
+  double susceptibility = 2.0;              // chi of eq. 2.1 (linear, saturable)
 
-  double volume() const;                     // V = 4/3 pi R^3
+  double volume() const;  // V = 4/3 pi R^3
   // mu0 Ms^2 V: the prefactor of every magnetic term of eq. 2.3, used as the internal energy unit.
   double magnetic_energy_scale() const;
 };
@@ -39,9 +39,9 @@ enum class PenaltyKind { tanh, wca };
 //       makes E continuous at r_cut (it is the text's 1/4 when r_cut = 2^(1/6) r_min).
 struct OverlapPenalty {
   PenaltyKind kind = PenaltyKind::tanh;
-  double e_max = 100.0;   // J (see docs/two-dipole-model.md for why joules)
-  double delta = 1e-2;    // 1/m, tanh width in u = 1/S - 1/(2R)
-  double r_min = 3e-6;    // m, WCA
+  double e_max = 100.0;                     // J (see docs/two-dipole-model.md for why joules)
+  double delta = 1e-2;                      // 1/m, tanh width in u = 1/S - 1/(2R)
+  double r_min = 3e-6;                      // m, WCA
   double r_cut = 3e-6 * 1.122462048309373;  // m, WCA, 2^(1/6) r_min
 
   static OverlapPenalty tanh_default(double radius);

@@ -1,18 +1,18 @@
 #include "mresim/pair/relaxation.hpp"
 
-#include "mresim/pair/relaxation_coordinates.hpp"
-
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "mresim/pair/relaxation_coordinates.hpp"
 
 namespace mresim::pair {
 namespace {
 
 template <int N>
 RelaxResult newton(const PairEnergy& energy, const Eigen::Vector3d& start_scaled,
-                     const RelaxOptions& opt) {
+                   const RelaxOptions& opt) {
   using C = detail::PolarCoordinates<N>;
   using Vec = typename C::Vec;
   using Mat = typename C::Mat;
@@ -53,7 +53,8 @@ RelaxResult newton(const PairEnergy& energy, const Eigen::Vector3d& start_scaled
     // soft direction, the gradient whose Newton step changes the energy by less than its
     // round-off. (A small Newton step alone is not enough: at the WCA cut-off the curvature
     // jumps, and the step from inside is tiny although the minimum lies outside.)
-    const double energy_resolution = 8.0 * std::numeric_limits<double>::epsilon() * (1.0 + std::abs(e));
+    const double energy_resolution =
+        8.0 * std::numeric_limits<double>::epsilon() * (1.0 + std::abs(e));
     bool at_resolution = eig.eigenvalues().minCoeff() > floor;
     for (int i = 0; i < N && at_resolution; ++i) {
       const double curvature = std::abs(hessian(i, i));

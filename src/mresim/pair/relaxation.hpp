@@ -14,9 +14,9 @@ struct RelaxOptions {
   RelaxMethod method = RelaxMethod::newton;
   double gradient_tolerance = 1e-12;  // on |dE/dd| in units of mu0 Ms^2 V / R
   int max_iterations = 2000;
-  double max_step = 0.25;             // largest move per iteration, in units of R
-  double step_tolerance = 1e-13;      // position resolution relative to |d|: a gradient that a
-                                      // displacement this small produces counts as converged
+  double max_step = 0.25;         // largest move per iteration, in units of R
+  double step_tolerance = 1e-13;  // position resolution relative to |d|: a gradient that a
+                                  // displacement this small produces counts as converged
 };
 
 struct RelaxResult {

@@ -10,8 +10,8 @@ PuljizStiffness puljiz_stiffness(double shear_modulus, double radius, double res
   const double q = radius / rest_separation;
   PuljizStiffness k;
   k.k0 = inv_m0 * (1.0 - 1.5 * q + 2.25 * q * q - 19.0 / 8.0 * q * q * q +
-                   93.0 / 16.0 * q * q * q * q);                          // eq. 2.8
-  k.k12 = inv_m0 * (1.5 * q + 19.0 / 8.0 * q * q * q);                    // eq. 2.9
+                   93.0 / 16.0 * q * q * q * q);        // eq. 2.8
+  k.k12 = inv_m0 * (1.5 * q + 19.0 / 8.0 * q * q * q);  // eq. 2.9
   return k;
 }
 

@@ -1,7 +1,8 @@
 #include "mresim/pair/runs/grid_axis.hpp"
 
-#include <cmath>
 #include <fmt/format.h>
+
+#include <cmath>
 
 namespace mresim::pair::runs {
 

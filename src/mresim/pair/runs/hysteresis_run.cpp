@@ -42,21 +42,21 @@ class HysteresisPlan final : public app::RunPlan {
     }
 
     io::CsvWriter summary(staging_dir / "summary.csv", loop_csv_columns());
-    io::CsvWriter critical(staging_dir / "critical_fields.csv",
-                           {"case", "label", "hysteresis", "HC1_T", "HC2_T", "dH_T",
-                            "uncertainty_T"});
+    io::CsvWriter critical(
+        staging_dir / "critical_fields.csv",
+        {"case", "label", "hysteresis", "HC1_T", "HC2_T", "dH_T", "uncertainty_T"});
     for (std::size_t c = 0; c < cases_.size(); ++c) {
       const std::string group = fmt::format("/cases/{}", c);
       append_loop_rows(summary, c, cases_[c], loops[c]);
       write_loop_hdf5(results, group, cases_[c], cases_[c].system(), loops[c]);
       write_critical_fields_hdf5(results, group + "/critical_fields", fields[c]);
-      critical.row_cells({static_cast<double>(c), cases_[c].label,
-                          fields[c].hysteresis ? 1.0 : 0.0, fields[c].hc1, fields[c].hc2,
-                          fields[c].delta(), fields[c].uncertainty});
+      critical.row_cells({static_cast<double>(c), cases_[c].label, fields[c].hysteresis ? 1.0 : 0.0,
+                          fields[c].hc1, fields[c].hc2, fields[c].delta(), fields[c].uncertainty});
       if (const std::size_t bad = unconverged_states(loops[c]); bad > 0) {
-        std::cerr << fmt::format("mresim: warning: case {} ({}): {} of {} states did not reach "
-                                 "the relaxation tolerance (see solver/converged)\n",
-                                 c, cases_[c].label, bad, loops[c].states.size());
+        std::cerr << fmt::format(
+            "mresim: warning: case {} ({}): {} of {} states did not reach "
+            "the relaxation tolerance (see solver/converged)\n",
+            c, cases_[c].label, bad, loops[c].states.size());
       }
     }
     results.write_int_attribute("/cases", "count", static_cast<std::int64_t>(cases_.size()));
@@ -64,7 +64,8 @@ class HysteresisPlan final : public app::RunPlan {
 
  private:
   std::string section(std::size_t i) const {
-    return cases_.size() == 1 ? std::string("pair") : fmt::format("case {}: {}", i, cases_[i].label);
+    return cases_.size() == 1 ? std::string("pair")
+                              : fmt::format("case {}: {}", i, cases_[i].label);
   }
 
   std::vector<PairSetup> cases_;

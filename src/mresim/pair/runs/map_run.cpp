@@ -43,11 +43,13 @@ class MapPlan final : public app::RunPlan {
     report.add_integer("map", "separation_count", static_cast<std::int64_t>(separations_.size()));
     report.add("map", "separation_first", separations_.front(), "m");
     report.add("map", "separation_last", separations_.back(), "m");
-    report.add_integer("map", "points", static_cast<std::int64_t>(rows_.size() * separations_.size()));
+    report.add_integer("map", "points",
+                       static_cast<std::int64_t>(rows_.size() * separations_.size()));
     SweepOptions quadrant = base_.sweep;
     quadrant.first_quadrant_only = true;
-    report.add_integer("map", "steps_per_point", static_cast<std::int64_t>(sweep_points(quadrant).size()),
-                       "", "first quadrant 0 -> +max -> 0; the loop is odd in B");
+    report.add_integer("map", "steps_per_point",
+                       static_cast<std::int64_t>(sweep_points(quadrant).size()), "",
+                       "first quadrant 0 -> +max -> 0; the loop is odd in B");
     if (row_parameter_ == "k") {
       for (std::size_t i = 0; i < rows_.size(); ++i) {
         report.add("eq. 2.10 threshold", fmt::format("S0_max(k = {:.4g} N/m)", rows_[i]),
@@ -62,8 +64,9 @@ class MapPlan final : public app::RunPlan {
     CriticalFieldOptions options;
     options.tolerance = base_.critical_field_tolerance;
     const CriticalFieldGrid grid = map_critical_fields(
-        rows_.size(), separations_.size(), [this](std::size_t r, std::size_t c) { return point(r, c); },
-        options, [&progress] { progress.advance(); });
+        rows_.size(), separations_.size(),
+        [this](std::size_t r, std::size_t c) { return point(r, c); }, options,
+        [&progress] { progress.advance(); });
     write(staging_dir, results, grid);
   }
 
@@ -83,8 +86,7 @@ class MapPlan final : public app::RunPlan {
              const CriticalFieldGrid& grid) const {
     const std::size_t rows = rows_.size(), cols = separations_.size();
     io::CsvWriter csv(dir / "summary.csv", {"row", "col", "row_value", "S0_m", "hysteresis",
-                                            "HC1_T", "HC2_T", "dH_T", "k12_N_per_m",
-                                            "k0_N_per_m"});
+                                            "HC1_T", "HC2_T", "dH_T", "k12_N_per_m", "k0_N_per_m"});
     std::vector<double> hc1, hc2, dh;
     std::vector<std::int64_t> hysteresis;
     for (std::size_t r = 0; r < rows; ++r) {
@@ -100,7 +102,8 @@ class MapPlan final : public app::RunPlan {
       }
     }
     h5.write_string_attribute("/map", "row_parameter", row_parameter_);
-    h5.write_number_attribute("/map", "critical_field_uncertainty_T", 0.5 * base_.critical_field_tolerance);
+    h5.write_number_attribute("/map", "critical_field_uncertainty_T",
+                              0.5 * base_.critical_field_tolerance);
     h5.write_vector("/map/row_values", rows_, row_parameter_ == "k" ? "N/m" : "deg");
     h5.write_vector("/map/separations", separations_, "m");
     h5.write_matrix("/map/HC1", rows, cols, hc1, "T");

@@ -1,7 +1,8 @@
 #include "mresim/pair/runs/pair_outputs.hpp"
 
-#include <algorithm>
 #include <fmt/format.h>
+
+#include <algorithm>
 
 #include "mresim/pair/overlap_penalty.hpp"
 #include "mresim/pair/stiffness.hpp"
@@ -9,10 +10,10 @@
 namespace mresim::pair::runs {
 
 std::vector<std::string> loop_csv_columns() {
-  return {"case",    "step",     "branch",   "B_T",       "S_m",       "S_minus_S0_m",
-          "theta_deg", "m1_x",   "m1_y",     "m1_z",      "m2_x",      "m2_y",
-          "m2_z",    "M_over_Ms", "saturated", "E_total_J", "E_zeeman_J", "E_dipole_J",
-          "E_self_J", "E_spring_J", "E_anchor_J", "E_penalty_J", "iterations", "converged"};
+  return {"case",      "step",       "branch",     "B_T",         "S_m",        "S_minus_S0_m",
+          "theta_deg", "m1_x",       "m1_y",       "m1_z",        "m2_x",       "m2_y",
+          "m2_z",      "M_over_Ms",  "saturated",  "E_total_J",   "E_zeeman_J", "E_dipole_J",
+          "E_self_J",  "E_spring_J", "E_anchor_J", "E_penalty_J", "iterations", "converged"};
 }
 
 void append_loop_rows(io::CsvWriter& csv, std::size_t case_index, const PairSetup& setup,
@@ -22,12 +23,29 @@ void append_loop_rows(io::CsvWriter& csv, std::size_t case_index, const PairSetu
     const PairState& s = loop.states[i];
     const Eigen::Vector3d& m = s.magnetization.m;
     const EnergyBreakdown& e = s.energy;
-    csv.row({static_cast<double>(case_index), static_cast<double>(i),
-             static_cast<double>(s.branch), s.field, s.distance(),
-             s.distance() - setup.rest_separation, s.rotation_deg(), m.x(), m.y(), m.z(), m.x(),
-             m.y(), m.z(), s.magnetization_along(direction),
-             s.magnetization.saturated ? 1.0 : 0.0, e.total(), e.zeeman, e.dipole, e.self,
-             e.spring, e.anchor, e.penalty, static_cast<double>(s.iterations),
+    csv.row({static_cast<double>(case_index),
+             static_cast<double>(i),
+             static_cast<double>(s.branch),
+             s.field,
+             s.distance(),
+             s.distance() - setup.rest_separation,
+             s.rotation_deg(),
+             m.x(),
+             m.y(),
+             m.z(),
+             m.x(),
+             m.y(),
+             m.z(),
+             s.magnetization_along(direction),
+             s.magnetization.saturated ? 1.0 : 0.0,
+             e.total(),
+             e.zeeman,
+             e.dipole,
+             e.self,
+             e.spring,
+             e.anchor,
+             e.penalty,
+             static_cast<double>(s.iterations),
              s.converged ? 1.0 : 0.0});
   }
 }
@@ -106,8 +124,8 @@ void describe_pair(app::InfoReport& report, const std::string& section, const Pa
                   setup.model == SpringModel::single ? "single (eq. 2.3)" : "three (eq. 2.4)");
   report.add_text(section, "stiffness_source", setup.stiffness.describe());
   report.add(section, "rest_separation", setup.rest_separation, "m", "S0");
-  const double k_eq = setup.model == SpringModel::single ? p.springs.k12
-                                                         : p.springs.k12 + 0.5 * p.springs.k0;
+  const double k_eq =
+      setup.model == SpringModel::single ? p.springs.k12 : p.springs.k12 + 0.5 * p.springs.k0;
   if (setup.model == SpringModel::single) {
     report.add(section, "k", p.springs.k12, "N/m");
   } else {
@@ -116,17 +134,18 @@ void describe_pair(app::InfoReport& report, const std::string& section, const Pa
     report.add(section, "k0_over_k12", p.springs.k0 / p.springs.k12, "");
   }
   report.add(section, "equivalent_single_k", k_eq, "N/m", "k0/2 + k12 (axial response)");
-  report.add(section, "youngs_modulus_chapter2", youngs_from_spring_chapter2(k_eq, m.radius,
-                                                                             setup.rest_separation),
-             "Pa", "E = k S0 / (pi R^2)");
-  report.add(section, "youngs_modulus_chapter3", youngs_from_spring_chapter3(k_eq, m.radius,
-                                                                             setup.rest_separation),
-             "Pa", "E = 2 k S0 / (pi D^2)");
+  report.add(section, "youngs_modulus_chapter2",
+             youngs_from_spring_chapter2(k_eq, m.radius, setup.rest_separation), "Pa",
+             "E = k S0 / (pi R^2)");
+  report.add(section, "youngs_modulus_chapter3",
+             youngs_from_spring_chapter3(k_eq, m.radius, setup.rest_separation), "Pa",
+             "E = 2 k S0 / (pi D^2)");
   const double threshold = clustering_threshold_separation(m, k_eq);
   report.add(section, "clustering_threshold_S0", threshold, "m",
              "eq. 2.10 with the equivalent k (field along the axis)");
-  report.add(section, "clustering_threshold_k", clustering_threshold_stiffness(m, setup.rest_separation),
-             "N/m", "eq. 2.10 solved for k at this S0");
+  report.add(section, "clustering_threshold_k",
+             clustering_threshold_stiffness(m, setup.rest_separation), "N/m",
+             "eq. 2.10 solved for k at this S0");
   report.add_text(section, "eq_2_10_predicts",
                   setup.rest_separation < threshold ? "clustering (hysteresis along the axis)"
                                                     : "no clustering");
@@ -144,14 +163,12 @@ void describe_pair(app::InfoReport& report, const std::string& section, const Pa
   report.add(section, "field_max", sw.b_max, "T");
   report.add(section, "field_step", sw.b_step, "T");
   report.add(section, "field_angle", sw.theta_h_deg, "deg",
-             setup.model == SpringModel::single && sw.theta_h_deg != 0.0 &&
-                     sw.theta_h_deg != 90.0
+             setup.model == SpringModel::single && sw.theta_h_deg != 0.0 && sw.theta_h_deg != 90.0
                  ? "single spring: the axis is held fixed (no rotational restoring force)"
                  : "");
-  report.add(section, "reduced_field_max", reduced_field(sw.b_max, m.saturation_magnetization),
-             "", "h = H/Ms at field_max");
-  report.add_integer(section, "steps_per_loop",
-                     static_cast<std::int64_t>(sweep_points(sw).size()));
+  report.add(section, "reduced_field_max", reduced_field(sw.b_max, m.saturation_magnetization), "",
+             "h = H/Ms at field_max");
+  report.add_integer(section, "steps_per_loop", static_cast<std::int64_t>(sweep_points(sw).size()));
   report.add(section, "critical_field_tolerance", setup.critical_field_tolerance, "T");
   report.add_text(section, "relaxation",
                   sw.relax.method == RelaxMethod::newton

@@ -1,7 +1,8 @@
 #include "mresim/pair/runs/pair_setup.hpp"
 
-#include <cmath>
 #include <fmt/format.h>
+
+#include <cmath>
 
 #include "mresim/pair/stiffness.hpp"
 
@@ -12,9 +13,12 @@ using config::TableReader;
 
 std::string StiffnessSource::describe() const {
   switch (kind) {
-    case Kind::spring_constant: return "spring constant k";
-    case Kind::three_spring_constants: return "spring constants k0, k12";
-    case Kind::shear_modulus: return "shear modulus (Puljiz, eqs. 2.8-2.9)";
+    case Kind::spring_constant:
+      return "spring constant k";
+    case Kind::three_spring_constants:
+      return "spring constants k0, k12";
+    case Kind::shear_modulus:
+      return "shear modulus (Puljiz, eqs. 2.8-2.9)";
     case Kind::youngs_modulus:
       return chapter3_cylinder ? "Young's modulus, Chapter 3 cylinder (k = E pi D^2 / (2 S0))"
                                : "Young's modulus, Chapter 2 cylinder (k = E pi R^2 / S0)";
@@ -60,8 +64,7 @@ PairSystem PairSetup::system_at(double s0) const {
 
 namespace {
 
-const std::vector<std::string> kStiffnessKeys{"k", "k0", "k12", "shear_modulus",
-                                              "youngs_modulus"};
+const std::vector<std::string> kStiffnessKeys{"k", "k0", "k12", "shear_modulus", "youngs_modulus"};
 
 void read_material(const TableReader& t, SphereMaterial& m) {
   m.radius = t.number_or("radius", m.radius, Range::positive(), "m");
@@ -80,8 +83,7 @@ bool read_stiffness(const TableReader& t, SpringModel model, StiffnessSource& ou
   const std::string convention =
       t.choice_or("youngs_convention", "chapter2", {"chapter2", "chapter3"});
   if (given.empty()) return false;
-  const bool pair_of_constants =
-      given.size() == 2 && given[0] == "k0" && given[1] == "k12";
+  const bool pair_of_constants = given.size() == 2 && given[0] == "k0" && given[1] == "k12";
   if (given.size() > 1 && !pair_of_constants) {
     t.fail(given[1], t.value_text(given[1]),
            fmt::format("give one stiffness: k, k0 and k12, shear_modulus or youngs_modulus "
@@ -166,8 +168,8 @@ PairSetup read_pair_setup(const TableReader& scope, const PairSetup& base, bool 
   PairSetup s = base;
   if (auto t = scope.optional_table("material")) read_material(*t, s.material);
 
-  std::optional<TableReader> springs =
-      is_root ? std::optional<TableReader>(scope.table("springs")) : scope.optional_table("springs");
+  std::optional<TableReader> springs = is_root ? std::optional<TableReader>(scope.table("springs"))
+                                               : scope.optional_table("springs");
   bool model_changed = false;
   if (springs) {
     const std::string model = springs->choice_or(
@@ -175,13 +177,15 @@ PairSetup read_pair_setup(const TableReader& scope, const PairSetup& base, bool 
     const SpringModel chosen = model == "single" ? SpringModel::single : SpringModel::three;
     model_changed = chosen != s.model;
     s.model = chosen;
-    s.rest_separation = springs->number_or("rest_separation", s.rest_separation,
-                                           Range::positive(), "m");
+    s.rest_separation =
+        springs->number_or("rest_separation", s.rest_separation, Range::positive(), "m");
     const bool given = read_stiffness(*springs, s.model, s.stiffness);
     if (!given && stiffness_required && (is_root || model_changed)) {
-      springs->fail("model", springs->value_text("model").empty() ? "\"" + model + "\"" : springs->value_text("model"),
-                    "needs a stiffness: k (single), k0 and k12 (three), shear_modulus, or "
-                    "youngs_modulus (single)");
+      springs->fail(
+          "model",
+          springs->value_text("model").empty() ? "\"" + model + "\"" : springs->value_text("model"),
+          "needs a stiffness: k (single), k0 and k12 (three), shear_modulus, or "
+          "youngs_modulus (single)");
     }
   }
   // The three-spring model uses the WCA by default (Section 2.5.3), the single spring tanh;
@@ -202,8 +206,8 @@ PairSetup read_pair_setup(const TableReader& scope, const PairSetup& base, bool 
         t->integer_or("max_iterations", s.sweep.relax.max_iterations, Range::between(1, 10000000)));
   }
   if (auto t = scope.optional_table("critical_fields")) {
-    s.critical_field_tolerance = t->number_or("tolerance", s.critical_field_tolerance,
-                                              Range::positive(), "T");
+    s.critical_field_tolerance =
+        t->number_or("tolerance", s.critical_field_tolerance, Range::positive(), "T");
     if (s.critical_field_tolerance >= s.sweep.b_step) {
       t->fail("tolerance", s.critical_field_tolerance,
               fmt::format("must be < field.step = {} T", s.sweep.b_step));

@@ -15,10 +15,10 @@ namespace mresim::pair::runs {
 struct StiffnessSource {
   enum class Kind { spring_constant, three_spring_constants, shear_modulus, youngs_modulus };
   Kind kind = Kind::spring_constant;
-  double k = 4e-2;        // N/m  (single spring: k; three springs: unused)
-  double k0 = 0.0;        // N/m
-  double k12 = 0.0;       // N/m
-  double modulus = 0.0;   // Pa, G or E
+  double k = 4e-2;                 // N/m  (single spring: k; three springs: unused)
+  double k0 = 0.0;                 // N/m
+  double k12 = 0.0;                // N/m
+  double modulus = 0.0;            // Pa, G or E
   bool chapter3_cylinder = false;  // youngs_modulus: k = E pi D^2/(2 S0) instead of E pi R^2/S0
 
   std::string describe() const;
