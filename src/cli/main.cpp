@@ -19,9 +19,7 @@ int report_error(const char* message, int status) {
   return status;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run_cli(int argc, char** argv) {
   using namespace mresim::cli;
 
   CLI::App app{
@@ -69,4 +67,16 @@ int main(int argc, char** argv) {
     return report_error(e.what(), kFailure);
   }
   return kFailure;  // unreachable: require_subcommand(1)
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run_cli(argc, argv);
+  } catch (const std::exception& e) {  // e.g. out of memory while setting up
+    return report_error(e.what(), mresim::cli::kFailure);
+  } catch (...) {
+    return report_error("unknown internal error", mresim::cli::kFailure);
+  }
 }

@@ -33,6 +33,7 @@ struct ChildResult {
 // sent to /dev/null.
 ChildResult spawn_and_wait(const std::vector<std::string>& args, bool quiet) {
   std::vector<char*> argv;
+  argv.reserve(args.size() + 1);
   for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
 
@@ -40,6 +41,7 @@ ChildResult spawn_and_wait(const std::vector<std::string>& args, bool quiet) {
   for (char** e = environ; *e != nullptr; ++e) env_storage.emplace_back(*e);
   if (std::getenv("MPLBACKEND") == nullptr) env_storage.emplace_back("MPLBACKEND=Agg");
   std::vector<char*> envp;
+  envp.reserve(env_storage.size() + 1);
   for (auto& e : env_storage) envp.push_back(e.data());
   envp.push_back(nullptr);
 

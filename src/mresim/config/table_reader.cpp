@@ -170,7 +170,7 @@ TableReader TableReader::parse_string(std::string_view text, std::string source_
                                   e.source().begin.line, e.source().begin.column, e.description()));
   }
   const void* root = &doc->root;
-  return TableReader(std::move(doc), root, "");
+  return {std::move(doc), root, ""};
 }
 
 std::string TableReader::path(std::string_view key) const { return join_path(path_, key); }
@@ -212,7 +212,7 @@ void TableReader::fail_missing(std::string_view key, std::string_view kind,
   std::size_t best_distance = typo_tolerance(key.size()) + 1;
   for (const auto& [k, node] : as_table(table_)) {
     const std::string_view name = k.str();
-    if (known != doc_->known.end() && known->second.count(std::string(name)) > 0) continue;
+    if (known != doc_->known.end() && known->second.contains(std::string(name))) continue;
     const std::size_t dist = edit_distance(key, name);
     if (dist < best_distance) {
       best_distance = dist;
@@ -410,7 +410,7 @@ void TableReader::reject_unknown_keys() const {
     for (const auto& [k, node] : table) {
       const std::string name(k.str());
       const std::string full = join_path(table_path, name);
-      const bool is_known = known != doc_->known.end() && known->second.count(name) > 0;
+      const bool is_known = known != doc_->known.end() && known->second.contains(name);
       if (!is_known) {
         std::string message;
         if (is_table_like(node)) {

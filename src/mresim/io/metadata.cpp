@@ -14,7 +14,8 @@ std::string utc_timestamp() {
   return buffer;
 }
 
-void write_run_metadata(Hdf5File& file, const config::TableReader& root, std::string run_type) {
+void write_run_metadata(Hdf5File& file, const config::TableReader& root,
+                        const std::string& run_type) {
   file.write_string_attribute("/", "mresim_version", kVersion);
   file.write_string_attribute("/", "run_type", run_type);
   file.write_string_attribute("/", "input_toml", root.source_text());

@@ -13,7 +13,8 @@ namespace mresim::io {
 //   input_toml      the complete run file, byte for byte
 //   input_file      the name the run file was read under
 //   created_utc     ISO 8601 time stamp, e.g. 2025-01-31T14:05:09Z
-void write_run_metadata(Hdf5File& file, const config::TableReader& root, std::string run_type);
+void write_run_metadata(Hdf5File& file, const config::TableReader& root,
+                        const std::string& run_type);
 
 // The current time as "YYYY-MM-DDTHH:MM:SSZ".
 std::string utc_timestamp();
