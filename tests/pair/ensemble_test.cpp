@@ -84,7 +84,7 @@ TEST(CriticalFieldMap, IsIdenticalForOneAndTwoThreads) {
   auto build = [](std::size_t row, std::size_t col) {
     MapPointSetup setup;
     setup.system.springs = {SpringModel::single, 1e-2 * (1.0 + 2.0 * static_cast<double>(row)), 0.0,
-                            4e-6 + 1.5e-6 * static_cast<double>(col)};
+                            4e-6 + 2.5e-6 * static_cast<double>(col)};
     setup.sweep.b_step = 0.02;
     return setup;
   };

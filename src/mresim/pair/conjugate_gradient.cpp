@@ -38,7 +38,8 @@ RelaxResult relax_conjugate_gradient(const PairEnergy& energy, const Eigen::Vect
     }
     // Bracket a minimum of phi(a) = E(q + a p): grow the trial step until the directional
     // derivative turns positive or the energy rises, then secant/bisect on phi'.
-    double lo = 0.0, slope_lo = slope0;
+    double lo = 0.0;
+    double slope_lo = slope0;
     // First trial: the minimiser of the quadratic through phi'(0) and the curvature probed with
     // a tiny step (capped at 1% of R). The bracket then closes at the first minimum along the
     // line, so a shallow basin near a critical field (a saddle a fraction of a nanometre past
@@ -50,7 +51,8 @@ RelaxResult relax_conjugate_gradient(const PairEnergy& energy, const Eigen::Vect
     const double curvature = (g_probe.dot(direction) - slope0) / probe;
     double hi = curvature > 0.0 ? std::min(cap, -slope0 / curvature) : cap;
     Vec g_trial;
-    double e_trial = 0.0, slope_hi = 0.0;
+    double e_trial = 0.0;
+    double slope_hi = 0.0;
     for (int grow = 0; grow < 60; ++grow) {
       e_trial = evaluate(q + hi * direction, g_trial);
       slope_hi = g_trial.dot(direction);

@@ -72,7 +72,8 @@ CriticalFields find_critical_fields(const PairSystem& system, const HysteresisLo
   const SweepOptions& sweep = loop.options;
   const double step = sweep.b_step;
   // First-quadrant states of the rising (branch 0) and falling (branch 1) legs by step index.
-  std::map<int, const PairState*> rising, falling;
+  std::map<int, const PairState*> rising;
+  std::map<int, const PairState*> falling;
   for (const PairState& s : loop.states) {
     const int j = static_cast<int>(std::lround(s.field / step));
     if (j < 0) continue;
@@ -83,7 +84,8 @@ CriticalFields find_critical_fields(const PairSystem& system, const HysteresisLo
   // Steps of the rising branch that move the pair by more than this (in R) are checked for a
   // bistable range narrower than the step.
   constexpr double kJumpFraction = 1e-2;
-  int first = -1, last = -1;
+  int first = -1;
+  int last = -1;
   for (const auto& [j, up] : rising) {
     auto down = falling.find(j);
     if (down == falling.end()) continue;

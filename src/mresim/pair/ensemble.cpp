@@ -83,7 +83,8 @@ std::vector<double> five_point_average(const std::vector<double>& values) {
   std::vector<double> out(values.size());
   const auto n = static_cast<long>(values.size());
   for (long i = 0; i < n; ++i) {
-    const long lo = std::max(0L, i - 2), hi = std::min(n - 1, i + 2);
+    const long lo = std::max(0L, i - 2);
+    const long hi = std::min(n - 1, i + 2);
     double sum = 0.0;
     for (long j = lo; j <= hi; ++j) sum += values[static_cast<std::size_t>(j)];
     out[static_cast<std::size_t>(i)] = sum / static_cast<double>(hi - lo + 1);

@@ -74,7 +74,8 @@ Eigen::Matrix3d PairEnergy::scaled_hessian(const Eigen::Vector3d& d) const {
   constexpr double kStep = 1e-6;  // the magnetic energy varies on the scale of R
   Eigen::Matrix3d h;
   for (int i = 0; i < 3; ++i) {
-    Eigen::Vector3d dp = d, dm = d;
+    Eigen::Vector3d dp = d;
+    Eigen::Vector3d dm = d;
     dp(i) += kStep;
     dm(i) -= kStep;
     h.col(i) =

@@ -82,7 +82,8 @@ RelaxResult newton(const PairEnergy& energy, const Eigen::Vector3d& start_scaled
       return (grad.array() / hessian.diagonal().array().abs().max(floor)).matrix().norm();
     };
     bool accepted = false;
-    for (double t = 1.0; t > 1e-14; t *= 0.5) {
+    double t = 1.0;
+    for (int halving = 0; halving < 47; ++halving, t *= 0.5) {  // down to t ~ 1e-14
       const Vec q_new = q + t * step;
       Vec g_new;
       Eigen::Vector3d g3_new;

@@ -12,8 +12,10 @@ std::vector<double> read_grid_axis(const config::TableReader& t, const std::stri
                                    const Range& allowed, const std::string& unit,
                                    const std::string& default_spacing) {
   const std::string values_key = name + "_values";
-  const std::string min_key = name + "_min", max_key = name + "_max";
-  const std::string count_key = name + "_count", spacing_key = name + "_spacing";
+  const std::string min_key = name + "_min";
+  const std::string max_key = name + "_max";
+  const std::string count_key = name + "_count";
+  const std::string spacing_key = name + "_spacing";
   const bool explicit_values = t.has(values_key);
   // Read every key so that both forms are known; then insist on exactly one form.
   const auto values = t.optional_number_list(values_key, allowed, unit, 1);

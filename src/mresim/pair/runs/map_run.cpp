@@ -51,9 +51,9 @@ class MapPlan final : public app::RunPlan {
                        static_cast<std::int64_t>(sweep_points(quadrant).size()), "",
                        "first quadrant 0 -> +max -> 0; the loop is odd in B");
     if (row_parameter_ == "k") {
-      for (std::size_t i = 0; i < rows_.size(); ++i) {
-        report.add("eq. 2.10 threshold", fmt::format("S0_max(k = {:.4g} N/m)", rows_[i]),
-                   clustering_threshold_separation(base_.material, rows_[i]), "m");
+      for (const double k : rows_) {
+        report.add("eq. 2.10 threshold", fmt::format("S0_max(k = {:.4g} N/m)", k),
+                   clustering_threshold_separation(base_.material, k), "m");
       }
     }
   }
@@ -84,10 +84,13 @@ class MapPlan final : public app::RunPlan {
 
   void write(const std::filesystem::path& dir, io::Hdf5File& h5,
              const CriticalFieldGrid& grid) const {
-    const std::size_t rows = rows_.size(), cols = separations_.size();
+    const std::size_t rows = rows_.size();
+    const std::size_t cols = separations_.size();
     io::CsvWriter csv(dir / "summary.csv", {"row", "col", "row_value", "S0_m", "hysteresis",
                                             "HC1_T", "HC2_T", "dH_T", "k12_N_per_m", "k0_N_per_m"});
-    std::vector<double> hc1, hc2, dh;
+    std::vector<double> hc1;
+    std::vector<double> hc2;
+    std::vector<double> dh;
     std::vector<std::int64_t> hysteresis;
     for (std::size_t r = 0; r < rows; ++r) {
       for (std::size_t c = 0; c < cols; ++c) {

@@ -54,9 +54,17 @@ void write_loop_hdf5(io::Hdf5File& h5, const std::string& group, const PairSetup
                      const PairSystem& system, const HysteresisLoop& loop) {
   const std::size_t n = loop.states.size();
   const Eigen::Vector3d direction = field_direction(loop.options.theta_h_deg);
-  std::vector<double> field, distance, rotation, along, total;
-  std::vector<double> separation, moment;
-  std::vector<std::int64_t> branch, iterations, converged, saturated;
+  std::vector<double> field;
+  std::vector<double> distance;
+  std::vector<double> rotation;
+  std::vector<double> along;
+  std::vector<double> total;
+  std::vector<double> separation;
+  std::vector<double> moment;
+  std::vector<std::int64_t> branch;
+  std::vector<std::int64_t> iterations;
+  std::vector<std::int64_t> converged;
+  std::vector<std::int64_t> saturated;
   std::vector<std::vector<double>> terms(6);
   for (const PairState& s : loop.states) {
     field.push_back(s.field);

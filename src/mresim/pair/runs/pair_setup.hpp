@@ -37,7 +37,7 @@ struct PairSetup {
 
   // The pair with its spring constants resolved at the current S0.
   PairSystem system() const;
-  PairSystem system_at(double rest_separation) const;
+  PairSystem system_at(double s0) const;
 };
 
 // Reads the setup from `scope` (the root, or one [[case]] table), every key falling back to
