@@ -10,6 +10,8 @@ namespace {
 InfoReport sample() {
   InfoReport report;
   report.add_text("run", "type", "pair_hysteresis");
+  report.add_text("run", "title", "a long title that has no note");
+  report.add_integer("run", "threads", 0, "", "0 = all cores");
   report.add("model", "k", 0.04, "N/m", "spring stiffness");
   report.add("model", "S0", 6e-6, "m");
   report.add_integer("field", "steps", 401);
@@ -20,7 +22,9 @@ InfoReport sample() {
 TEST(InfoReport, TextGroupsSectionsInOrderAndAlignsColumns) {
   EXPECT_EQ(sample().to_text(),
             "[run]\n"
-            "  type  pair_hysteresis\n"
+            "  type     pair_hysteresis\n"
+            "  title    a long title that has no note\n"
+            "  threads  0  0 = all cores\n"
             "\n"
             "[model]\n"
             "  k            0.04 N/m  spring stiffness\n"

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <mresim/core/version.hpp>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <string>
 
 #include "../support/hdf5_read.hpp"
@@ -114,7 +115,8 @@ TEST(Cli, TypesListsTheRegisteredRunTypes) {
   EXPECT_EQ(mresim(dir.path(), "types").status, 0);
   const Result r = testbed(dir.path(), "types");
   EXPECT_EQ(r.status, 0);
-  EXPECT_NE(r.out.find("test_dummy  Test-only run type"), std::string::npos) << r.out;
+  EXPECT_TRUE(std::regex_search(r.out, std::regex(R"((^|\n)  test_dummy +Test-only run type\n)")))
+      << r.out;
 }
 
 TEST(Cli, AnInvalidRunFileExitsWith2AndWritesNothing) {
@@ -230,7 +232,7 @@ TEST(Cli, InfoDescribesTheRunAsTextOrJson) {
             "  file     demo.toml\n"
             "  type     test_dummy\n"
             "  title    CLI test\n"
-            "  threads  0           0 = all cores\n"
+            "  threads  0  0 = all cores\n"
             "\n"
             "[dummy]\n"
             "  steps         3\n"

@@ -64,7 +64,9 @@ std::string InfoReport::to_text() const {
     for (const auto& e : entries_) {
       if (e.section != section) continue;
       key_width = std::max(key_width, e.key.size());
-      value_width = std::max(value_width, value_text(e).size());
+      // Notes line up after the widest annotated value; a long unannotated value (a title)
+      // must not push every note far to the right.
+      if (!e.note.empty()) value_width = std::max(value_width, value_text(e).size());
     }
     if (!out.empty()) out += '\n';
     out += fmt::format("[{}]\n", section);
