@@ -38,6 +38,8 @@ struct GradientCase {
   double step;
 };
 
+void PrintTo(const GradientCase& c, std::ostream* os) { *os << c.name; }
+
 class PairEnergyGradient : public ::testing::TestWithParam<GradientCase> {};
 
 // Every term of eq. 2.3/2.4 (Zeeman, dipole, self, springs, penalty) with the relaxed

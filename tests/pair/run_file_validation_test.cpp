@@ -50,6 +50,9 @@ struct BadInput {
   std::string message;
 };
 
+// Names the case in test output instead of dumping the struct's bytes.
+void PrintTo(const BadInput& input, std::ostream* os) { *os << input.name; }
+
 class PairRunFileErrors : public ::testing::TestWithParam<BadInput> {};
 
 TEST_P(PairRunFileErrors, NameTheKeyTheValueAndWhatIsAllowed) {
