@@ -3,6 +3,10 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "mresim/app/run_type.hpp"
+#include "mresim/config/table_reader.hpp"
+#include "mresim/io/run_directory.hpp"
+
 namespace mresim::cli {
 
 // Each command registers its options on the CLI11 app and runs from the parsed values.
@@ -16,6 +20,21 @@ struct RunOptions {
 };
 CLI::App* add_run_command(CLI::App& app, RunOptions& options);
 int run_command(const RunOptions& options);
+
+// Shared by run and resume: executes the plan into run_dir's staging directory (results.h5
+// with the run's metadata), commits it and draws the figures. Returns the exit status.
+int execute_and_publish(const config::TableReader& root, const app::RunPlan& plan,
+                        const std::string& run_type, io::RunDirectory& run_dir, long threads_option,
+                        bool no_plot);
+
+// `mresim resume DIR`: continues an interrupted run from its last checkpoint.
+struct ResumeOptions {
+  std::string dir;
+  long threads = -1;
+  bool no_plot = false;
+};
+CLI::App* add_resume_command(CLI::App& app, ResumeOptions& options);
+int resume_command(const ResumeOptions& options);
 
 struct InfoOptions {
   std::string file;

@@ -36,7 +36,9 @@ int run_cli(int argc, char** argv) {
   RunOptions run_options;
   InfoOptions info_options;
   PlotOptions plot_options;
+  ResumeOptions resume_options;
   CLI::App* run = add_run_command(app, run_options);
+  CLI::App* resume = add_resume_command(app, resume_options);
   CLI::App* info = add_info_command(app, info_options);
   CLI::App* plot = add_plot_command(app, plot_options);
   CLI::App* types = add_types_command(app);
@@ -56,6 +58,7 @@ int run_cli(int argc, char** argv) {
 
   try {
     if (*run) return run_command(run_options);
+    if (*resume) return resume_command(resume_options);
     if (*info) return info_command(info_options);
     if (*plot) return plot_command(plot_options);
     if (*types) return types_command();

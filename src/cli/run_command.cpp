@@ -37,22 +37,30 @@ int run_command(const RunOptions& options) {
   const auto root = config::TableReader::parse_file(options.file);
   std::string run_type;
   const auto plan = app::make_plan(root, &run_type);
-  const app::RunSettings settings = app::read_run_settings(root);
 
   // 2. Claim the output directory (refused if it holds something other than an mresim run).
   const fs::path out = options.out.empty() ? fs::path(options.file).stem() : fs::path(options.out);
   io::RunDirectory run_dir(out);
 
+  return execute_and_publish(root, *plan, run_type, run_dir, options.threads, options.no_plot);
+}
+
+int execute_and_publish(const config::TableReader& root, const app::RunPlan& plan,
+                        const std::string& run_type, io::RunDirectory& run_dir, long threads_option,
+                        bool no_plot) {
+  const app::RunSettings settings = app::read_run_settings(root);
+  const fs::path& out = run_dir.final_path();
+
   // 3. Compute into the staging directory; an exception removes it (RunDirectory destructor).
   const int threads =
-      app::configure_threads(options.threads >= 0 ? options.threads : settings.threads);
+      app::configure_threads(threads_option >= 0 ? threads_option : settings.threads);
   {
     io::Hdf5File results(run_dir.path() / io::RunDirectory::kMarkerFile);
     io::write_run_metadata(results, root, run_type);
     results.write_string_attribute("/", "title", settings.title);
     results.write_int_attribute("/", "threads", threads);
     app::Progress progress(0, run_type);
-    plan->execute(run_dir.path(), results, progress);
+    plan.execute(run_dir.path(), results, progress);
     progress.finish();
     results.close();
   }
@@ -62,7 +70,7 @@ int run_command(const RunOptions& options) {
   std::printf("mresim: results written to %s\n", out.string().c_str());
   std::fflush(stdout);
 
-  if (options.no_plot) return kSuccess;
+  if (no_plot) return kSuccess;
   if (draw_figures(run_dir.final_path()) != 0) {
     std::fprintf(stderr,
                  "mresim: error: drawing the figures failed; the results are complete in '%s' "

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <vector>
 
 namespace mresim::io {
 
@@ -24,6 +25,27 @@ std::string staging_prefix(const fs::path& final_dir) {
 // Whether a process with this id is running (kill with signal 0 only checks).
 bool process_alive(pid_t pid) { return ::kill(pid, 0) == 0 || errno != ESRCH; }
 
+// The staging directories of finished processes for `final_dir`.
+std::vector<fs::path> stale_staging(const fs::path& final_dir) {
+  const std::string prefix = staging_prefix(final_dir);
+  std::vector<fs::path> out;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(final_dir.parent_path(), ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(prefix, 0) != 0) continue;
+    const std::string digits = name.substr(prefix.size());
+    if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    if (!process_alive(static_cast<pid_t>(std::stol(digits)))) out.push_back(entry.path());
+  }
+  return out;
+}
+
+fs::path normalised_final(const fs::path& final_dir) {
+  fs::path out = fs::absolute(final_dir).lexically_normal();
+  if (out.filename().empty()) out = out.parent_path();  // "results/" -> "results"
+  return out;
+}
+
 }  // namespace
 
 bool RunDirectory::is_run_directory(const fs::path& dir) {
@@ -31,10 +53,41 @@ bool RunDirectory::is_run_directory(const fs::path& dir) {
   return fs::is_directory(dir, ec) && fs::is_regular_file(dir / kMarkerFile, ec);
 }
 
-RunDirectory::RunDirectory(const fs::path& final_dir) : shown_(final_dir) {
-  final_ = fs::absolute(final_dir).lexically_normal();
-  if (final_.filename().empty()) final_ = final_.parent_path();  // "results/" -> "results"
+void RunDirectory::resolve_final(const fs::path& final_dir) {
+  shown_ = final_dir;
+  final_ = normalised_final(final_dir);
   check_replaceable();
+}
+
+fs::path RunDirectory::find_interrupted(const fs::path& final_dir, const fs::path& file) {
+  fs::path best;
+  fs::file_time_type best_time;
+  std::error_code ec;
+  for (const fs::path& dir : stale_staging(normalised_final(final_dir))) {
+    if (!fs::is_regular_file(dir / file, ec)) continue;
+    const fs::file_time_type t = fs::last_write_time(dir / file, ec);
+    if (best.empty() || t > best_time) {
+      best = dir;
+      best_time = t;
+    }
+  }
+  return best;
+}
+
+RunDirectory::RunDirectory(const fs::path& final_dir, const fs::path& interrupted_staging) {
+  resolve_final(final_dir);
+  staging_ = final_.parent_path() / (staging_prefix(final_) + std::to_string(::getpid()));
+  std::error_code ec;
+  fs::rename(interrupted_staging, staging_, ec);
+  if (ec) {
+    staging_.clear();  // nothing of ours to remove
+    throw OutputDirectoryError(
+        fmt::format("cannot take over '{}': {}", interrupted_staging.string(), ec.message()));
+  }
+}
+
+RunDirectory::RunDirectory(const fs::path& final_dir) {
+  resolve_final(final_dir);
 
   std::error_code ec;
   fs::create_directories(final_.parent_path(), ec);
@@ -70,15 +123,8 @@ void RunDirectory::check_replaceable() const {
 }
 
 void RunDirectory::remove_stale_staging() const {
-  const std::string prefix = staging_prefix(final_);
   std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(final_.parent_path(), ec)) {
-    const std::string name = entry.path().filename().string();
-    if (name.rfind(prefix, 0) != 0) continue;
-    const std::string digits = name.substr(prefix.size());
-    if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos) continue;
-    if (!process_alive(static_cast<pid_t>(std::stol(digits)))) fs::remove_all(entry.path(), ec);
-  }
+  for (const fs::path& dir : stale_staging(final_)) fs::remove_all(dir, ec);
 }
 
 void RunDirectory::commit() {

@@ -27,6 +27,16 @@ class RunDirectory {
   // Throws OutputDirectoryError if `final_dir` exists and is not replaceable, or if the staging
   // directory cannot be created.
   explicit RunDirectory(const std::filesystem::path& final_dir);
+
+  // Resuming an interrupted run: takes over `interrupted_staging` (found by find_interrupted)
+  // as this process's staging directory, keeping its contents. Same checks as above.
+  RunDirectory(const std::filesystem::path& final_dir,
+               const std::filesystem::path& interrupted_staging);
+
+  // The staging directory of an interrupted run to `final_dir` (its process no longer exists)
+  // that contains `file`; the most recently modified one if there are several; empty if none.
+  static std::filesystem::path find_interrupted(const std::filesystem::path& final_dir,
+                                                const std::filesystem::path& file);
   ~RunDirectory();
   RunDirectory(const RunDirectory&) = delete;
   RunDirectory& operator=(const RunDirectory&) = delete;
@@ -44,6 +54,7 @@ class RunDirectory {
   static bool is_run_directory(const std::filesystem::path& dir);
 
  private:
+  void resolve_final(const std::filesystem::path& final_dir);
   void check_replaceable() const;
   void remove_stale_staging() const;
 

@@ -10,9 +10,6 @@ namespace mresim::mess {
 
 namespace mm = mresim::magnetism;
 
-// WCA energy scale of the original code, whatever the run's Ms (reference-notes.md section 1).
-inline constexpr double kSeedWcaMs = 1.9e6;
-
 MessSettings MessSettings::for_profile(lattice::Profile profile) {
   MessSettings s;
   s.elastic = ElasticTermSettings::for_profile(profile);
@@ -52,7 +49,7 @@ MessSystem MessSystem::make(lattice::Lattice lattice, const Eigen::Vector3d& app
   mm::MagneticParticles p = particles;
   p.radius = lattice.particle_radius > 0.0 ? lattice.particle_radius : p.radius;
   const lattice::Profile profile = lattice.profile;
-  const double wca_ms = profile == lattice::Profile::seed ? kSeedWcaMs : p.Ms;
+  const double wca_ms = profile == lattice::Profile::seed ? mm::kSeedWcaMs : p.Ms;
   mm::MagneticModel model = mm::MagneticModel::make(p, applied_field, wca_ms);
   return {std::move(lattice), std::move(model), MessSettings::for_profile(profile)};
 }

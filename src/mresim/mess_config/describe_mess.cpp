@@ -21,9 +21,6 @@ constexpr double kRadian = 180.0 / std::numbers::pi;
 constexpr std::size_t kCentresShown = 64;
 constexpr std::size_t kClosestPairLimit = 4000;
 
-// WCA energy scale Ms of the seed profile (reference-notes section 1).
-constexpr double kSeedWcaMs = 1.9e6;
-
 const char* axis_name(int a) { return a == 0 ? "x" : a == 1 ? "y" : "z"; }
 
 std::string with_thousands(std::int64_t n) {
@@ -174,7 +171,7 @@ void describe_particles(const MessSpec& s, app::InfoReport& r) {
                  : "eq. 4.73, the dissertation's energy plots");
   const bool seed = s.lattice.profile == lattice::Profile::seed;
   const magnetism::WcaParameters wca =
-      magnetism::WcaParameters::from_radius(p.radius, seed ? kSeedWcaMs : p.Ms);
+      magnetism::WcaParameters::from_radius(p.radius, seed ? magnetism::kSeedWcaMs : p.Ms);
   r.add(sec, "wca_energy", wca.e_max, "J",
         seed ? "mu0 pi Ms^2 R^3/72 with Ms = 1.9e6 A/m (seed profile)"
              : "mu0 pi Ms^2 R^3/72, eq. 4.79");

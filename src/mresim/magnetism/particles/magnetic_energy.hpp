@@ -47,6 +47,10 @@ struct WcaParameters {
   static WcaParameters from_radius(double radius, double ms_scale, double gap = 100e-9);
 };
 
+// The seed profile scales the WCA energy with this Ms whatever the run's Ms (the original code
+// hard-codes it; reference-notes.md section 1).
+inline constexpr double kSeedWcaMs = 1.9e6;  // A/m
+
 // Everything the magnetic terms need besides the centres and M.
 struct MagneticModel {
   MagneticParticles particles;

@@ -1,0 +1,108 @@
+// Run types of the 3D model (Chapter 4): mess_hysteresis, mess_strain, mess_magnetostriction,
+// mess_stress. One plan for all four: the run file's MessSpec says which protocol the
+// ProtocolRunner follows. Checkpoints go to the staging directory after every
+// [output] checkpoint_every steps; `mresim resume` hands the interrupted staging directory back
+// to execute(), which continues from its checkpoint.
+
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "mresim/app/run_type.hpp"
+#include "mresim/mess_config/mess_spec.hpp"
+#include "mresim/mess_protocol/checkpoint.hpp"
+#include "mresim/mess_protocol/mess_outputs.hpp"
+#include "mresim/mess_protocol/protocol_runner.hpp"
+
+namespace mresim::mess_protocol {
+namespace {
+
+namespace fs = std::filesystem;
+namespace mc = mresim::mess_config;
+
+class MessPlan final : public app::RunPlan {
+ public:
+  MessPlan(const config::TableReader& root, std::string_view type)
+      : spec_(mc::read_mess_spec(root, type)),
+        input_toml_(root.source_text()),
+        input_name_(root.source_name()) {}
+
+  void describe(app::InfoReport& report) const override { mc::describe_mess(spec_, report); }
+
+  void execute(const fs::path& staging_dir, io::Hdf5File& results,
+               app::Progress& progress) const override {
+    ProtocolRunner runner(spec_);
+    const fs::path checkpoint = staging_dir / kCheckpointFile;
+    ProtocolState state = fs::exists(checkpoint) ? read_checkpoint(checkpoint, runner, input_toml_)
+                                                 : runner.initial_state();
+    const std::size_t total = runner.steps().size();
+    if (state.next_step > 0) {
+      std::cerr << fmt::format("mresim: resuming at step {} of {} from the checkpoint\n",
+                               state.next_step, total);
+    }
+    progress.set_total(total);
+    progress.advance(state.next_step);
+
+    const long every = spec_.output.checkpoint_every;
+    runner.run(state, [&](const ProtocolState& s) {
+      if (spec_.output.node_positions) {
+        write_step_positions(staging_dir, s.records.back().step.index, runner.system().positions());
+      }
+      if (every > 0 && s.next_step < total && s.next_step % static_cast<std::size_t>(every) == 0) {
+        write_checkpoint(checkpoint, s, runner, input_toml_, input_name_);
+      }
+      progress.advance();
+    });
+
+    write_mess_results(staging_dir, results, runner, state.records);
+    warn_about_unconverged(state.records);
+    std::error_code ec;
+    fs::remove(checkpoint, ec);  // the results hold everything now
+  }
+
+ private:
+  static void warn_about_unconverged(const std::vector<StepRecord>& records) {
+    std::size_t relaxation = 0;
+    std::size_t magnetization = 0;
+    for (const StepRecord& r : records) {
+      if (!r.converged) ++relaxation;
+      if (r.unconverged_magnetization_solves > 0) ++magnetization;
+    }
+    if (relaxation > 0) {
+      std::cerr << fmt::format(
+          "mresim: warning: {} of {} steps did not converge (see /steps/solver in results.h5)\n",
+          relaxation, records.size());
+    }
+    if (magnetization > 0) {
+      std::cerr << fmt::format(
+          "mresim: warning: in {} of {} steps some magnetization solve missed its tolerance "
+          "(see /steps/solver/unconverged_magnetization_solves)\n",
+          magnetization, records.size());
+    }
+  }
+
+  mc::MessSpec spec_;
+  std::string input_toml_;
+  std::string input_name_;
+};
+
+app::RunType mess_run_type(const char* name, const char* summary) {
+  return {name, summary, [name](const config::TableReader& root) {
+            return std::make_unique<MessPlan>(root, name);
+          }};
+}
+
+const app::RunTypeRegistrar hysteresis(mess_run_type(
+    "mess_hysteresis", "3D lattice (MESS): field loop with all faces held (Chapter 4)"));
+const app::RunTypeRegistrar strain(mess_run_type(
+    "mess_strain", "3D lattice (MESS): shear, tension, compression or torsion; G_eff / E_eff"));
+const app::RunTypeRegistrar magnetostriction(mess_run_type(
+    "mess_magnetostriction", "3D lattice (MESS): field series with only the bottom face held"));
+const app::RunTypeRegistrar stress(mess_run_type(
+    "mess_stress", "3D lattice (MESS): applied shear, tension or compression stress"));
+
+}  // namespace
+}  // namespace mresim::mess_protocol
