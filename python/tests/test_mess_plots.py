@@ -1,0 +1,80 @@
+"""Figures of the 3D run types (python/mresim_plots/mess.py) from synthetic results.h5 files
+(tests/mess_fixtures.py).
+
+    /usr/bin/python3 -m unittest discover python/tests -k Mess
+"""
+
+import os
+import sys
+import unittest
+
+import h5py
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import mess_fixtures  # noqa: E402
+from test_plots import PlotTestCase  # noqa: E402
+
+COMMON = ["energies.png", "particle_magnetization.png"]
+FIELD_SWEEP = COMMON + ["separation_magnetization.png"]
+MODULUS = COMMON + ["energy_density_fit.png", "modulus.png", "mr_effect.png"]
+
+
+class MessPlotTest(PlotTestCase):
+    def test_hysteresis_without_positions(self):
+        d = mess_fixtures.make_hysteresis(self.dir("hyst"))
+        self.assert_figures(d, FIELD_SWEEP, absent=["lattice_cut.png", "modulus.png"])
+
+    def test_hysteresis_with_position_files(self):
+        d = mess_fixtures.make_hysteresis(self.dir("hyst_pos"), positions="files")
+        self.assert_figures(d, FIELD_SWEEP + ["lattice_cut.png"])
+
+    def test_magnetostriction_with_positions_in_results(self):
+        d = mess_fixtures.make_magnetostriction(self.dir("ms"), positions="results")
+        self.assert_figures(d, FIELD_SWEEP + ["lattice_cut.png"])
+
+    def test_strain_with_kink_and_position_files(self):
+        d = mess_fixtures.make_strain(self.dir("strain"), positions="files")
+        self.assert_figures(d, MODULUS + ["lattice_cut.png"],
+                            absent=["separation_magnetization.png", "stress_strain.png"])
+
+    def test_strain_without_reference_modulus(self):
+        # modulus at the first field NaN: the MR effect is undefined everywhere.
+        d = mess_fixtures.make_strain(self.dir("strain_nan"), positions=None, mr_nan=True)
+        self.assert_figures(d, MODULUS)
+
+    def test_strain_without_measured_strain_uses_load(self):
+        d = mess_fixtures.make_strain(self.dir("strain_old"), positions=None)
+        with h5py.File(os.path.join(d, "results.h5"), "a") as f:
+            del f["steps/measured_strain"]
+        self.assert_figures(d, MODULUS)
+
+    def test_strain_without_analysis_draws_curves_only(self):
+        d = mess_fixtures.make_strain(self.dir("strain_noanalysis"), positions=None)
+        with h5py.File(os.path.join(d, "results.h5"), "a") as f:
+            del f["analysis"]
+        self.assert_figures(d, COMMON + ["energy_density_fit.png"],
+                            absent=["modulus.png", "mr_effect.png"])
+
+    def test_stress(self):
+        d = mess_fixtures.make_stress(self.dir("stress"))
+        self.assert_figures(d, MODULUS + ["stress_strain.png"], absent=["lattice_cut.png"])
+
+    def test_positions_without_initial_positions_are_skipped(self):
+        d = mess_fixtures.make_magnetostriction(self.dir("ms_noinit"), positions="results")
+        with h5py.File(os.path.join(d, "results.h5"), "a") as f:
+            del f["lattice/initial_positions"]
+        self.assert_figures(d, FIELD_SWEEP, absent=["lattice_cut.png"])
+
+    def test_missing_steps_fails_with_one_line(self):
+        d = mess_fixtures.make_magnetostriction(self.dir("ms_broken"), positions=None)
+        with h5py.File(os.path.join(d, "results.h5"), "a") as f:
+            del f["steps"]
+        from test_plots import plot
+        result = plot(d)
+        self.assertEqual(result.returncode, 1, result.stdout + result.stderr)
+        self.assertEqual(len(result.stderr.strip().splitlines()), 1, result.stderr)
+        self.assertIn("/steps", result.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()
