@@ -214,3 +214,20 @@ TEST(MessModulusFit, MrEffectPercent) {
   EXPECT_TRUE(std::isnan(ma::mr_effect_percent(5000.0, -1.0)));
   EXPECT_TRUE(std::isnan(ma::mr_effect_percent(5000.0, std::numeric_limits<double>::quiet_NaN())));
 }
+
+// reference-notes.md section 18: a zero-strain point above the next one is not fitted.
+TEST(MessModulusFit, ZeroStrainPointAboveTheNextIsDropped) {
+  const auto x = strains(0.0, 0.01, 6);
+  auto u = parabola(x, kModulus, -3387.0);
+  u[0] += 0.5;  // above u[1] = c + a 1e-4 / 2 = c + 0.2
+  const auto fit = ma::fit_energy_density(x, u);
+  ASSERT_TRUE(fit.valid);
+  EXPECT_EQ(fit.first, 1U);
+  EXPECT_EQ(fit.points, 5U);
+  EXPECT_FALSE(fit.split);
+  EXPECT_NEAR(fit.modulus, kModulus, 1e-6 * kModulus);
+  EXPECT_NEAR(fit.offset, -3387.0, 1e-9);
+  // Below the next point it stays.
+  u[0] -= 0.45;
+  EXPECT_EQ(ma::fit_energy_density(x, u).first, 0U);
+}

@@ -31,8 +31,16 @@ QuadraticFit fit_energy_density(const std::vector<double>& strain,
     throw std::invalid_argument("fit_energy_density: strain and energy density differ in size");
   }
   QuadraticFit fit;
-  const std::size_t n = strain.size();
-  const std::size_t kept = points_before_kink(energy_density);
+  // The zero-strain point above the next one is dropped (reference-notes.md section 18).
+  fit.first =
+      energy_density.size() >= 3 && strain[0] == 0.0 && energy_density[1] < energy_density[0] ? 1
+                                                                                              : 0;
+  const std::vector<double> x_fit(strain.begin() + static_cast<std::ptrdiff_t>(fit.first),
+                                  strain.end());
+  const std::vector<double> u_fit(energy_density.begin() + static_cast<std::ptrdiff_t>(fit.first),
+                                  energy_density.end());
+  const std::size_t n = x_fit.size();
+  const std::size_t kept = points_before_kink(u_fit);
   // Fewer than 3 points before the kink cannot determine a and c with any redundancy; the
   // header's rule then fits the whole curve.
   if (kept < n && kept >= 3) {
@@ -45,7 +53,7 @@ QuadraticFit fit_energy_density(const std::vector<double>& strain,
   // Two unknowns need two distinct x^2; equal |x| (e.g. +-gamma only) leaves a undetermined.
   bool distinct = false;
   for (std::size_t i = 1; i < fit.points && !distinct; ++i) {
-    distinct = std::abs(strain[i]) != std::abs(strain[0]);
+    distinct = std::abs(x_fit[i]) != std::abs(x_fit[0]);
   }
   if (!distinct) return fit;
 
@@ -57,10 +65,10 @@ QuadraticFit fit_energy_density(const std::vector<double>& strain,
   Eigen::MatrixX2d design(m, 2);
   Eigen::VectorXd u(m);
   for (Eigen::Index i = 0; i < m; ++i) {
-    const double x = strain[static_cast<std::size_t>(i)];
+    const double x = x_fit[static_cast<std::size_t>(i)];
     design(i, 0) = 0.5 * x * x;
     design(i, 1) = 1.0;
-    u(i) = energy_density[static_cast<std::size_t>(i)];
+    u(i) = u_fit[static_cast<std::size_t>(i)];
   }
   const Eigen::Vector2d coefficients = design.colPivHouseholderQr().solve(u);
   fit.modulus = coefficients(0);

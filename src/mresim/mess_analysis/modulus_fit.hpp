@@ -14,6 +14,11 @@
 // spacing a parabola's increments can shrink too) and compares neighbouring increments only: a
 // jump up is kept, but the ordinary increment after it is smaller and cuts there. Non-finite
 // values are not screened (a NaN compares false and propagates into the fit).
+//
+// Like the original (reference-notes.md section 18), a first point at zero strain is dropped
+// when the next point lies below it (a zero-strain state that shearing relaxes further, e.g. a
+// squeezed polymer gap that buckles sideways once the symmetry is broken); the split rule then
+// applies to the curve from the second point on.
 
 #include <cstddef>
 #include <vector>
@@ -24,7 +29,8 @@ struct QuadraticFit {
   double modulus = 0.0;       // a, Pa (J/m^3 per strain^2)
   double offset = 0.0;        // c, J/m^3
   double rms_residual = 0.0;  // J/m^3, over the fitted points
-  std::size_t points = 0;     // fitted points (the first `points` of the curve)
+  std::size_t first = 0;      // index of the first fitted point (1: zero-strain point dropped)
+  std::size_t points = 0;     // fitted points: first .. first + points - 1
   bool split = false;         // the curve was cut (kink detected)
   bool valid = false;         // at least 2 points with distinct |x|
 };

@@ -72,8 +72,13 @@ void write_lattice(io::Hdf5File& results, const ProtocolRunner& runner) {
 }
 
 struct StepExtras {
-  std::vector<double> field_projection, magnetization_projection, energy_density, separation;
-  std::vector<std::int64_t> cluster_count, largest_cluster, cluster_id;
+  std::vector<double> field_projection;
+  std::vector<double> magnetization_projection;
+  std::vector<double> energy_density;
+  std::vector<double> separation;
+  std::vector<std::int64_t> cluster_count;
+  std::vector<std::int64_t> largest_cluster;
+  std::vector<std::int64_t> cluster_id;  // steps x particles
 };
 
 StepExtras step_extras(const ProtocolRunner& runner, const std::vector<StepRecord>& records) {
@@ -110,10 +115,18 @@ void write_analysis(const fs::path& run_dir, io::Hdf5File& results, const Protoc
                     const std::vector<StepRecord>& records, const StepExtras& extras) {
   const mc::MessSpec& spec = runner.spec();
   const std::size_t fields = spec.field.values.size();
-  std::vector<double> magnitude, modulus, offset, rms, mr;
-  std::vector<std::int64_t> points, split;
+  std::vector<double> magnitude;
+  std::vector<double> modulus;
+  std::vector<double> offset;
+  std::vector<double> rms;
+  std::vector<double> mr;
+  std::vector<std::int64_t> first;
+  std::vector<std::int64_t> points;
+  std::vector<std::int64_t> split;
   for (std::size_t f = 0; f < fields; ++f) {
-    std::vector<double> strain, density, stress;
+    std::vector<double> strain;
+    std::vector<double> density;
+    std::vector<double> stress;
     for (std::size_t i = 0; i < records.size(); ++i) {
       if (records[i].step.field_index != f) continue;
       strain.push_back(records[i].measured_strain);
@@ -126,9 +139,11 @@ void write_analysis(const fs::path& run_dir, io::Hdf5File& results, const Protoc
       modulus.push_back(fit.valid ? fit.modulus : std::numeric_limits<double>::quiet_NaN());
       offset.push_back(fit.offset);
       rms.push_back(fit.rms_residual);
+      first.push_back(static_cast<std::int64_t>(fit.first));
       points.push_back(static_cast<std::int64_t>(fit.points));
       split.push_back(fit.split ? 1 : 0);
     } else {
+      first.push_back(0);
       const ma::LinearFit fit = ma::fit_stress_strain(strain, stress);
       modulus.push_back(fit.valid ? fit.modulus : std::numeric_limits<double>::quiet_NaN());
       offset.push_back(0.0);
@@ -149,16 +164,18 @@ void write_analysis(const fs::path& run_dir, io::Hdf5File& results, const Protoc
   results.write_vector("/analysis/modulus", modulus, unit);
   results.write_vector("/analysis/offset", offset, "J/m^3");
   results.write_vector("/analysis/rms_residual", rms, spec.strain ? "J/m^3" : "Pa");
+  results.write_int_vector("/analysis/first_point", first);
   results.write_int_vector("/analysis/fit_points", points);
   results.write_int_vector("/analysis/split", split);
   results.write_vector("/analysis/mr_effect", mr, "%");
 
-  io::CsvWriter csv(run_dir / "modulus.csv",
-                    {"field_index", "B_T", name + (name == "torsion_stiffness" ? "_J_m3" : "_Pa"),
-                     "offset_J_m3", "rms_residual", "fit_points", "mr_effect_percent"});
+  io::CsvWriter csv(
+      run_dir / "modulus.csv",
+      {"field_index", "B_T", name + (name == "torsion_stiffness" ? "_J_m3" : "_Pa"), "offset_J_m3",
+       "rms_residual", "first_point", "fit_points", "mr_effect_percent"});
   for (std::size_t f = 0; f < fields; ++f) {
     csv.row({static_cast<double>(f), magnitude[f], modulus[f], offset[f], rms[f],
-             static_cast<double>(points[f]), mr[f]});
+             static_cast<double>(first[f]), static_cast<double>(points[f]), mr[f]});
   }
 }
 
