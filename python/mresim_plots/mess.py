@@ -130,6 +130,8 @@ class MessData:
             self.field_magnitude = _array(a, "field_magnitude", np.full(fields, math.nan))
             self.offset = _array(a, "offset", np.zeros(fields))
             self.fit_points = _array(a, "fit_points", np.full(fields, -1)).astype(int)  # -1: all
+            # Index of the first fitted point (1 when the zero-strain point was dropped).
+            self.first_point = _array(a, "first_point", np.zeros(fields)).astype(int)
             self.mr_effect = _array(a, "mr_effect", np.full(fields, math.nan))
             self.last_positions = self._last_positions(f)
         ms = run.config.get("particles", {}).get("saturation_magnetization", DEFAULT_MS)
@@ -369,26 +371,29 @@ def energy_density_fit(run, data):
         x, u = data.strain[steps], data.energy_density[steps]
         a = data.modulus[k] if k < data.modulus.size else math.nan
         c = data.offset[k] if k < data.offset.size else math.nan
+        first = int(data.first_point[k]) if k < data.first_point.size else 0
         fitted = data.fit_points[k] if k < data.fit_points.size else -1
-        fitted = x.size if fitted < 0 else min(fitted, x.size)
+        fitted = x.size - first if fitted < 0 else min(fitted, x.size - first)
+        in_fit = np.zeros(x.size, dtype=bool)
+        in_fit[first:first + fitted] = True
         fit_ok = not stress and math.isfinite(a) and math.isfinite(c)
         shift = c if fit_ok else np.nanmin(u)
         label = data.field_label(k)
         if fit_ok:
             label += f": {_modulus_symbol(data)} = {a / scale:.3g} {unit}"
-        ax.plot(x[:fitted], u[:fitted] - shift, "o", color=color, markersize=4, label=label)
-        if fitted < x.size:
+        ax.plot(x[in_fit], u[in_fit] - shift, "o", color=color, markersize=4, label=label)
+        if not in_fit.all():
             unfitted = True
-            ax.plot(x[fitted:], u[fitted:] - shift, "o", color=color, markersize=4,
+            ax.plot(x[~in_fit], u[~in_fit] - shift, "o", color=color, markersize=4,
                     markerfacecolor="none")
         if fit_ok and fitted >= 2:
-            xs = np.linspace(np.min(x[:fitted]), np.max(x[:fitted]), 100)
+            xs = np.linspace(np.min(x[in_fit]), np.max(x[in_fit]), 100)
             ax.plot(xs, 0.5 * a * xs**2, "-", color=color, linewidth=1.0)
     handles, labels = ax.get_legend_handles_labels()
     if unfitted:
         handles.append(Line2D([], [], color="0.3", marker="o", markerfacecolor="none",
                               linestyle="none"))
-        labels.append("not fitted (after the kink)")
+        labels.append("not fitted (zero strain above the next point, or after the kink)")
     if not stress:
         handles.append(Line2D([], [], color="0.3"))
         labels.append(r"fit $u = a x^2/2 + c$")
