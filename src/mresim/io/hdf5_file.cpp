@@ -254,6 +254,18 @@ void Hdf5File::write_array(std::string_view dataset_path, const std::vector<std:
   write_dataset(dataset_path, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, c_order.data(), unit);
 }
 
+void Hdf5File::write_int_array(std::string_view dataset_path, const std::vector<std::size_t>& dims,
+                               const std::vector<std::int64_t>& c_order) {
+  const auto count = std::accumulate(dims.begin(), dims.end(), std::size_t{1},
+                                     [](std::size_t a, std::size_t b) { return a * b; });
+  if (count != c_order.size()) {
+    throw std::invalid_argument(fmt::format(
+        "dataset '{}' in '{}': shape [{}] needs {} values, got {}", absolute(dataset_path),
+        path_.string(), fmt::join(dims, ", "), count, c_order.size()));
+  }
+  write_dataset(dataset_path, H5T_STD_I64LE, H5T_NATIVE_INT64, dims, c_order.data(), {});
+}
+
 void Hdf5File::write_string_vector(std::string_view dataset_path,
                                    const std::vector<std::string>& values) {
   std::vector<const char*> pointers;

@@ -52,6 +52,9 @@ class Hdf5File {
   // Any rank (e.g. steps x particles x 3), C order, dims.size() >= 1.
   void write_array(std::string_view dataset_path, const std::vector<std::size_t>& dims,
                    const std::vector<double>& c_order, std::string_view unit);
+  // Integers of any rank (e.g. cells x 8 node indices), C order, no unit.
+  void write_int_array(std::string_view dataset_path, const std::vector<std::size_t>& dims,
+                       const std::vector<std::int64_t>& c_order);
   void write_string_vector(std::string_view dataset_path, const std::vector<std::string>& values);
 
   // Pushes buffered data to disk (useful before a long computation step).

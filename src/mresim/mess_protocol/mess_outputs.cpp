@@ -66,7 +66,7 @@ void write_lattice(io::Hdf5File& results, const ProtocolRunner& runner) {
   for (const auto& e : lat.elements) {
     for (const int v : kVtkOrder) cells.push_back(e[static_cast<std::size_t>(v)]);
   }
-  results.write_int_vector("/lattice/cells", cells);
+  results.write_int_array("/lattice/cells", {lat.elements.size(), 8}, cells);
   std::vector<std::int64_t> particle_id(lat.particle_of_node.begin(), lat.particle_of_node.end());
   results.write_int_vector("/lattice/particle_id", particle_id);
 }
@@ -266,9 +266,7 @@ void write_mess_results(const fs::path& run_dir, io::Hdf5File& results,
   results.write_vector("/steps/separation", x.separation, "m");
   results.write_int_vector("/steps/cluster_count", x.cluster_count);
   results.write_int_vector("/steps/largest_cluster", x.largest_cluster);
-  // Steps x particles; stored as reals (the writer's arrays of rank > 1 are real).
-  results.write_array("/steps/cluster_id", {records.size(), np},
-                      std::vector<double>(x.cluster_id.begin(), x.cluster_id.end()), "1");
+  results.write_int_array("/steps/cluster_id", {records.size(), np}, x.cluster_id);
   write_summary(run_dir, records, x, unit);
   if (spec.strain || spec.stress) write_analysis(run_dir, results, runner, records, x);
   if (spec.output.node_positions) write_xdmf(run_dir, runner, records);
