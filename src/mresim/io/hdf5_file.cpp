@@ -8,6 +8,8 @@
 #include <type_traits>
 #include <utility>
 
+#include "mresim/io/hdf5_silence.hpp"
+
 namespace mresim::io {
 
 static_assert(std::is_same_v<hid_t, std::int64_t>, "Hdf5File stores hid_t as std::int64_t");
@@ -34,21 +36,7 @@ class Handle {
   Closer closer_;
 };
 
-// HDF5 prints its error stack to stderr by default; we turn it into exception messages instead.
-class SilenceHdf5Errors {
- public:
-  SilenceHdf5Errors() {
-    H5Eget_auto2(H5E_DEFAULT, &old_func_, &old_data_);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  }
-  ~SilenceHdf5Errors() { H5Eset_auto2(H5E_DEFAULT, old_func_, old_data_); }
-  SilenceHdf5Errors(const SilenceHdf5Errors&) = delete;
-  SilenceHdf5Errors& operator=(const SilenceHdf5Errors&) = delete;
-
- private:
-  H5E_auto2_t old_func_ = nullptr;
-  void* old_data_ = nullptr;
-};
+using detail::SilenceHdf5Errors;
 
 // The innermost description on HDF5's error stack ("name already exists"), then clears it.
 std::string last_hdf5_error() {
@@ -242,27 +230,26 @@ void Hdf5File::write_matrix(std::string_view dataset_path, std::size_t rows, std
   write_array(dataset_path, {rows, cols}, row_major, unit);
 }
 
-void Hdf5File::write_array(std::string_view dataset_path, const std::vector<std::size_t>& dims,
-                           const std::vector<double>& c_order, std::string_view unit) {
+void Hdf5File::check_shape(std::string_view dataset_path, const std::vector<std::size_t>& dims,
+                           std::size_t value_count) const {
   const auto count = std::accumulate(dims.begin(), dims.end(), std::size_t{1},
                                      [](std::size_t a, std::size_t b) { return a * b; });
-  if (count != c_order.size()) {
+  if (count != value_count) {
     throw std::invalid_argument(fmt::format(
         "dataset '{}' in '{}': shape [{}] needs {} values, got {}", absolute(dataset_path),
-        path_.string(), fmt::join(dims, ", "), count, c_order.size()));
+        path_.string(), fmt::join(dims, ", "), count, value_count));
   }
+}
+
+void Hdf5File::write_array(std::string_view dataset_path, const std::vector<std::size_t>& dims,
+                           const std::vector<double>& c_order, std::string_view unit) {
+  check_shape(dataset_path, dims, c_order.size());
   write_dataset(dataset_path, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, c_order.data(), unit);
 }
 
 void Hdf5File::write_int_array(std::string_view dataset_path, const std::vector<std::size_t>& dims,
                                const std::vector<std::int64_t>& c_order) {
-  const auto count = std::accumulate(dims.begin(), dims.end(), std::size_t{1},
-                                     [](std::size_t a, std::size_t b) { return a * b; });
-  if (count != c_order.size()) {
-    throw std::invalid_argument(fmt::format(
-        "dataset '{}' in '{}': shape [{}] needs {} values, got {}", absolute(dataset_path),
-        path_.string(), fmt::join(dims, ", "), count, c_order.size()));
-  }
+  check_shape(dataset_path, dims, c_order.size());
   write_dataset(dataset_path, H5T_STD_I64LE, H5T_NATIVE_INT64, dims, c_order.data(), {});
 }
 

@@ -65,6 +65,9 @@ class Hdf5File {
  private:
   [[noreturn]] void fail(std::string_view action, std::string_view object_path) const;
   void require_open(std::string_view object_path) const;
+  // Throws std::invalid_argument unless the product of dims is value_count.
+  void check_shape(std::string_view dataset_path, const std::vector<std::size_t>& dims,
+                   std::size_t value_count) const;
   // Opens the object (creating the group if it does not exist); returns an hid_t.
   [[nodiscard]] std::int64_t open_object(std::string_view object_path);
   void write_attribute(std::string_view object_path, std::string_view name, std::int64_t type,

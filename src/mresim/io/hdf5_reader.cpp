@@ -5,25 +5,13 @@
 
 #include <stdexcept>
 
+#include "mresim/io/hdf5_silence.hpp"
+
 namespace mresim::io {
 
 namespace {
 
-// Failures become exceptions; HDF5's own stack print is switched off while we call it.
-class QuietErrors {
- public:
-  QuietErrors() {
-    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  }
-  ~QuietErrors() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
-  QuietErrors(const QuietErrors&) = delete;
-  QuietErrors& operator=(const QuietErrors&) = delete;
-
- private:
-  H5E_auto2_t func_ = nullptr;
-  void* data_ = nullptr;
-};
+using QuietErrors = detail::SilenceHdf5Errors;
 
 hid_t utf8_string_type() {
   const hid_t type = H5Tcopy(H5T_C_S1);
