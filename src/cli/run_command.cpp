@@ -49,7 +49,7 @@ int execute_and_publish(const config::TableReader& root, const app::RunPlan& pla
                         const std::string& run_type, io::RunDirectory& run_dir, long threads_option,
                         bool no_plot) {
   const app::RunSettings settings = app::read_run_settings(root);
-  const fs::path& out = run_dir.final_path();
+  const fs::path& out = run_dir.shown_path();
 
   // 3. Compute into the staging directory; an exception removes it (RunDirectory destructor).
   const int threads =

@@ -128,6 +128,30 @@ TEST(RunDirectory, RemovesStagingLeftByAKilledRun) {
   EXPECT_TRUE(fs::exists(unrelated));
 }
 
+// `mresim resume`: the staging directory of a finished process that holds the marker file is
+// found, taken over with its contents, and committed like a fresh run.
+TEST(RunDirectory, ResumesTheStagingDirectoryOfAnInterruptedRun) {
+  const TempDir dir;
+  const auto interrupted = dir / "run.partial-99999999";  // no such process (above pid_max)
+  const auto without_checkpoint = dir / "run.partial-99999998";
+  fs::create_directories(interrupted);
+  fs::create_directories(without_checkpoint);
+  write_text(interrupted / "checkpoint.h5", "state");
+  EXPECT_EQ(RunDirectory::find_interrupted(dir / "run", "checkpoint.h5"), interrupted);
+  EXPECT_TRUE(RunDirectory::find_interrupted(dir / "other", "checkpoint.h5").empty());
+  {
+    RunDirectory run(dir / "run", interrupted);
+    EXPECT_EQ(run.path(), dir.path() / ("run.partial-" + std::to_string(::getpid())));
+    EXPECT_EQ(read_text(run.path() / "checkpoint.h5"), "state");
+    EXPECT_FALSE(fs::exists(interrupted));
+    write_text(run.path() / "results.h5", "done");
+    run.commit();
+  }
+  EXPECT_EQ(read_text(dir / "run" / "checkpoint.h5"), "state");
+  EXPECT_EQ(read_text(dir / "run" / "results.h5"), "done");
+  EXPECT_THROW(RunDirectory(dir / "run2", dir / "run2.partial-1"), OutputDirectoryError);
+}
+
 TEST(RunDirectory, CommitTwiceIsAProgrammingError) {
   const TempDir dir;
   RunDirectory run(dir / "run");

@@ -44,6 +44,8 @@ class RunDirectory {
   // Where to write outputs until commit().
   [[nodiscard]] const std::filesystem::path& path() const { return staging_; }
   [[nodiscard]] const std::filesystem::path& final_path() const { return final_; }
+  // The final directory as the user gave it (for messages).
+  [[nodiscard]] const std::filesystem::path& shown_path() const { return shown_; }
 
   // Moves the staging directory to the final path, replacing an earlier run atomically (Linux
   // renameat2 RENAME_EXCHANGE; a two-step rename where the file system lacks it). Close every
