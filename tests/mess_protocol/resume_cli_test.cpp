@@ -60,8 +60,8 @@ fs::path staged_checkpoint(const fs::path& dir, const std::string& out) {
 
 TEST(MessResumeCli, KilledRunResumedGivesTheSameResults) {
   const TempDir dir;
-  // 31 steps of a few tens of milliseconds: long enough to be killed in the middle.
-  const std::string toml = mresim::mess_protocol::testing::small_hysteresis(0.2, 6);
+  // 51 steps of a few tens of milliseconds each: killed a few steps after its first checkpoint.
+  const std::string toml = mresim::mess_protocol::testing::small_hysteresis(0.2, 10);
   { std::ofstream(dir / "run.toml") << toml; }
   ASSERT_EQ(mresim_status(dir.path(), "run run.toml --out full --no-plot -j 2"), 0);
 
@@ -74,8 +74,8 @@ TEST(MessResumeCli, KilledRunResumedGivesTheSameResults) {
     int status = 0;
     if (::waitpid(pid, &status, WNOHANG) == pid) break;  // finished before we could kill it
     if (!checkpoint.empty()) {
-      // Let it get a few steps past the first checkpoint, then kill it outright.
-      std::this_thread::sleep_for(std::chrono::milliseconds(300));
+      // Let it get a step or so past the first checkpoint, then kill it outright.
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
       ::kill(pid, SIGKILL);
       ::waitpid(pid, &status, 0);
       killed = WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL;
@@ -88,6 +88,9 @@ TEST(MessResumeCli, KilledRunResumedGivesTheSameResults) {
 
   ASSERT_EQ(mresim_status(dir.path(), "resume killed --no-plot -j 2"), 0)
       << mresim::testing::read_text(dir / ".stderr");
+  // It continued from the checkpoint rather than starting over.
+  EXPECT_NE(mresim::testing::read_text(dir / ".stderr").find("resuming at step"),
+            std::string::npos);
   ASSERT_TRUE(fs::exists(dir / "killed" / "results.h5"));
   EXPECT_FALSE(fs::exists(dir / "killed" / "checkpoint.h5"));
 
@@ -100,7 +103,7 @@ TEST(MessResumeCli, KilledRunResumedGivesTheSameResults) {
     EXPECT_EQ(a.doubles(path), b.doubles(path)) << path;
   }
   EXPECT_EQ(a.ints("/steps/solver/iterations"), b.ints("/steps/solver/iterations"));
-  EXPECT_EQ(a.doubles("/steps/field").size(), 31U * 3U);
+  EXPECT_EQ(a.doubles("/steps/field").size(), 51U * 3U);
 }
 
 TEST(MessResumeCli, NothingToResumeIsAnInputError) {
