@@ -7,6 +7,7 @@
 #include "cli/commands.hpp"
 #include "cli/exit_status.hpp"
 #include "cli/plotting.hpp"
+#include "mresim/app/invalid_results.hpp"
 #include "mresim/app/run_type.hpp"
 #include "mresim/app/threads.hpp"
 #include "mresim/config/table_reader.hpp"
@@ -54,14 +55,22 @@ int execute_and_publish(const config::TableReader& root, const app::RunPlan& pla
   // 3. Compute into the staging directory; an exception removes it (RunDirectory destructor).
   const int threads =
       app::configure_threads(threads_option >= 0 ? threads_option : settings.threads);
+  // A run whose results are written but partly invalid (non-finite, unconverged) is still
+  // published, with the bad entries marked, and ends with an error (exit status 4).
+  std::string invalid_results;
   {
     io::Hdf5File results(run_dir.path() / io::RunDirectory::kMarkerFile);
     io::write_run_metadata(results, root, run_type);
     results.write_string_attribute("/", "title", settings.title);
     results.write_int_attribute("/", "threads", threads);
     app::Progress progress(0, run_type);
-    plan.execute(run_dir.path(), results, progress);
+    try {
+      plan.execute(run_dir.path(), results, progress);
+    } catch (const app::InvalidResults& e) {
+      invalid_results = e.what();
+    }
     progress.finish();
+    results.write_string_attribute("/", "invalid_results", invalid_results);
     results.close();
   }
 
@@ -69,16 +78,21 @@ int execute_and_publish(const config::TableReader& root, const app::RunPlan& pla
   run_dir.commit();
   std::printf("mresim: results written to %s\n", out.string().c_str());
   std::fflush(stdout);
-
-  if (no_plot) return kSuccess;
-  if (draw_figures(run_dir.final_path()) != 0) {
+  const int plot_status = no_plot ? kSuccess : draw_figures(run_dir.final_path());
+  if (plot_status != kSuccess) {
     std::fprintf(stderr,
                  "mresim: error: drawing the figures failed; the results are complete in '%s' "
                  "(retry with 'mresim plot %s')\n",
                  out.string().c_str(), out.string().c_str());
-    return kPlotFailed;
   }
-  return kSuccess;
+  if (!invalid_results.empty()) {
+    std::fprintf(stderr,
+                 "mresim: error: %s; the results in '%s' are kept with these entries marked "
+                 "invalid\n",
+                 invalid_results.c_str(), out.string().c_str());
+    return kInvalidResults;
+  }
+  return plot_status == kSuccess ? kSuccess : kPlotFailed;
 }
 
 }  // namespace mresim::cli
