@@ -133,6 +133,15 @@ class MessData:
             # Index of the first fitted point (1 when the zero-strain point was dropped).
             self.first_point = _array(a, "first_point", np.zeros(fields)).astype(int)
             self.mr_effect = _array(a, "mr_effect", np.full(fields, math.nan))
+            # Fit validity (docs/outputs-3d.md): invalid fits are drawn hollow and grey, never
+            # as data. Files without the flags: a finite modulus counts as valid.
+            self.fit_valid = _array(a, "valid", np.isfinite(self.modulus)).astype(bool) \
+                & np.isfinite(self.modulus)
+            self.fit_problem = [_text(p) for p in a["problem"][()]] \
+                if a is not None and "problem" in a else [""] * fields
+            mr_default = self.fit_valid & (self.fit_valid[:1] if fields else self.fit_valid)
+            self.mr_valid = _array(a, "mr_effect_valid", mr_default).astype(bool) \
+                & np.isfinite(self.mr_effect)
             self.last_positions = self._last_positions(f)
         ms = run.config.get("particles", {}).get("saturation_magnetization", DEFAULT_MS)
         self.ms = float(ms)
@@ -376,11 +385,14 @@ def energy_density_fit(run, data):
         fitted = x.size - first if fitted < 0 else min(fitted, x.size - first)
         in_fit = np.zeros(x.size, dtype=bool)
         in_fit[first:first + fitted] = True
-        fit_ok = not stress and math.isfinite(a) and math.isfinite(c)
+        valid = bool(data.fit_valid[k]) if k < data.fit_valid.size else False
+        fit_ok = not stress and valid and math.isfinite(a) and math.isfinite(c)
         shift = c if fit_ok else np.nanmin(u)
         label = data.field_label(k)
         if fit_ok:
             label += f": {_modulus_symbol(data)} = {a / scale:.3g} {unit}"
+        elif not stress:
+            label += ": no valid fit"
         ax.plot(x[in_fit], u[in_fit] - shift, "o", color=color, markersize=4, label=label)
         if not in_fit.all():
             unfitted = True
@@ -417,10 +429,12 @@ def stress_strain(run, data):
         x, s = data.strain[steps], data.load_value[steps]
         a = data.modulus[k] if k < data.modulus.size else math.nan
         label = data.field_label(k)
-        if math.isfinite(a):
+        if k < data.fit_valid.size and data.fit_valid[k]:
             label += f": {_modulus_symbol(data)} = {a / scale:.3g} {unit}"
             xs = np.linspace(min(0.0, np.min(x)), max(0.0, np.max(x)), 50)
             ax.plot(xs, a * xs, "-", color=color, linewidth=1.0)
+        else:
+            label += ": no valid fit"
         ax.plot(x, s, "o", color=color, markersize=4, label=label)
     ax.set_xlabel(strain_label(run, data))
     ax.set_ylabel(f"applied stress ({data.load_unit or 'Pa'})")
@@ -444,13 +458,21 @@ def _modulus_unit(data):
     return MODULUS_LABELS.get(data.modulus_name, ("", "kPa"))[1], 1e3
 
 
+INVALID_FIT_LABEL = "invalid fit, not a result"
+INVALID_COLOR = "0.6"
+
+
 def modulus(run, data):
-    """Fig. 4.18: the effective modulus against |B|."""
+    """Fig. 4.18: the effective modulus against |B|. Invalid fits (too few points, an
+    unconverged step, wrong curvature; /analysis/valid = 0) are drawn hollow and grey, apart
+    from the line through the valid ones."""
     unit, scale = _modulus_unit(data)
     fig, ax = plt.subplots(figsize=(6.4, 4.8), layout="constrained")
     b_mt = data.field_magnitude * 1e3
-    ok = np.isfinite(data.modulus)
-    ax.plot(b_mt[ok], data.modulus[ok] / scale, "o-", color="C0", markersize=5)
+    ok = data.fit_valid
+    ax.plot(b_mt[ok], data.modulus[ok] / scale, "o-", color="C0", markersize=5,
+            label=_modulus_symbol(data))
+    _draw_invalid(ax, b_mt, data.modulus / scale, ok)
     _note_missing(ax, b_mt, ok, "no valid fit")
     ax.set_xlabel(ABS_FIELD_LABEL)
     ax.set_ylabel(f"{_modulus_symbol(data)} ({unit})")
@@ -460,18 +482,29 @@ def modulus(run, data):
 
 
 def mr_effect(run, data):
-    """(modulus / modulus at the first field - 1) x 100 % against |B| (Section 4.3)."""
+    """(modulus / modulus at the first field - 1) x 100 % against |B| (Section 4.3); values
+    from an invalid fit (here or at the first field) hollow and grey."""
     fig, ax = plt.subplots(figsize=(6.4, 4.8), layout="constrained")
     b_mt = data.field_magnitude * 1e3
-    ok = np.isfinite(data.mr_effect)
-    ax.plot(b_mt[ok], data.mr_effect[ok], "s-", color="C3", markersize=5)
-    _note_missing(ax, b_mt, ok, "undefined (no valid modulus at the first field)")
+    ok = data.mr_valid
+    ax.plot(b_mt[ok], data.mr_effect[ok], "s-", color="C3", markersize=5, label="MR effect")
+    _draw_invalid(ax, b_mt, data.mr_effect, ok, marker="s")
+    _note_missing(ax, b_mt, ok, "undefined (no valid modulus here or at the first field)")
     ax.axhline(0.0, color="0.6", linewidth=0.8, zorder=0)
     ax.set_xlabel(ABS_FIELD_LABEL)
     ax.set_ylabel(f"MR effect of {_modulus_symbol(data)} (%)")
     ax.grid(alpha=0.25)
     run.suptitle(fig)
     run.save(fig, "mr_effect.png")
+
+
+def _draw_invalid(ax, x, y, ok, marker="o"):
+    """The finite values of invalid fits: hollow grey markers, no line, one legend entry."""
+    shown = ~ok & np.isfinite(y) & np.isfinite(x)
+    if np.any(shown):
+        ax.plot(x[shown], y[shown], marker, linestyle="none", color=INVALID_COLOR,
+                markerfacecolor="none", markersize=6, label=INVALID_FIT_LABEL)
+        ax.legend(fontsize=8, loc="best")
 
 
 def _note_missing(ax, b_mt, ok, why):

@@ -168,9 +168,11 @@ def make_magnetostriction(directory, positions="results"):
                      magnetizations(m_along), positions=positions)
 
 
-def make_strain(directory, positions="files", mr_nan=False):
+def make_strain(directory, positions="files", mr_nan=False, invalid_field=None):
     """Simple shear 0 .. 0.1 rad at 4 fields; at the largest field the energy density drops at
-    the 8th strain (clustering), so only 7 points are fitted."""
+    the 8th strain (clustering), so only 7 points are fitted. invalid_field: the index of a
+    field whose fit is marked invalid (/analysis/valid = 0, only 2 points) while its modulus
+    stays a finite number, as mresim writes it."""
     fields = np.array([0.0, 0.02, 0.05, 0.1])
     gammas = np.linspace(0.0, 0.1, 11)
     moduli = 4e3 * (1 + 0.4 * np.arange(fields.size) ** 1.5)
@@ -190,10 +192,20 @@ def make_strain(directory, positions="files", mr_nan=False):
     if mr_nan:
         modulus[0] = np.nan
         mr[:] = np.nan
+    valid = np.isfinite(modulus).astype(np.int64)
+    problem = [""] * fields.size
+    if invalid_field is not None:
+        valid[invalid_field] = 0
+        fit_points[invalid_field] = 2
+        modulus[invalid_field] *= 3.0  # the nonsense value an invalid fit gives
+        mr[invalid_field] = (modulus[invalid_field] / modulus[0] - 1) * 100
+        problem[invalid_field] = "only 2 point(s) fitted, at least 3 needed"
+    mr_valid = valid * valid[0]
     analysis = dict(modulus_name="G_eff", field_magnitude=fields, modulus=modulus,
                     offset=offsets, rms_residual=np.full(fields.size, 1e-3),
                     fit_points=fit_points, split=(fit_points < gammas.size).astype(np.int64),
-                    mr_effect=mr)
+                    mr_effect=mr, valid=valid, problem=np.array(problem, dtype=object),
+                    mr_effect_valid=mr_valid)
     return write_run(directory, "mess_strain", along_z(fields[f_idx]), f_idx, l_idx, gamma, "rad",
                      u, pair_centres(s), magnetizations(m_along), measured_strain=strain,
                      analysis=analysis, positions=positions)

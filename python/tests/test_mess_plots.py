@@ -11,6 +11,7 @@ import unittest
 import h5py
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # python/
 import mess_fixtures  # noqa: E402
 from test_plots import PlotTestCase  # noqa: E402
 
@@ -64,6 +65,51 @@ class MessPlotTest(PlotTestCase):
         with h5py.File(os.path.join(d, "results.h5"), "a") as f:
             del f["lattice/initial_positions"]
         self.assert_figures(d, FIELD_SWEEP, absent=["lattice_cut.png"])
+
+    def test_strain_with_invalid_fit_draws_it_hollow(self):
+        d = mess_fixtures.make_strain(self.dir("strain_invalid"), positions=None,
+                                      invalid_field=2)
+        self.assert_figures(d, MODULUS)
+
+    def test_invalid_fit_is_not_plotted_as_data(self):
+        # In process: the figures are kept open and their lines inspected.
+        from mresim_plots import common, mess
+        d = mess_fixtures.make_strain(self.dir("strain_invalid_lines"), positions=None,
+                                      invalid_field=2)
+        figures = {}
+
+        class KeepFigures(common.Run):
+            def save(self, fig, name):
+                figures[name] = fig
+
+        run = KeepFigures(d)
+        data = mess.MessData(run)
+        mess.modulus(run, data)
+        mess.mr_effect(run, data)
+        mess.energy_density_fit(run, data)
+        invalid_b = data.field_magnitude[2] * 1e3
+        for name in ("modulus.png", "mr_effect.png"):
+            lines = figures[name].axes[0].get_lines()
+            data_lines = [ln for ln in lines if ln.get_label() != mess.INVALID_FIT_LABEL
+                          and ln.get_marker() not in ("None", "", None)]
+            invalid = [ln for ln in lines if ln.get_label() == mess.INVALID_FIT_LABEL]
+            self.assertTrue(data_lines, name)
+            for ln in data_lines:
+                self.assertNotIn(invalid_b, list(ln.get_xdata()), name)
+            self.assertEqual(len(invalid), 1, name)
+            self.assertEqual(list(invalid[0].get_xdata()), [invalid_b], name)
+            self.assertEqual(invalid[0].get_markerfacecolor(), "none", name)
+            self.assertEqual(invalid[0].get_linestyle(), "None", name)
+            legend = figures[name].axes[0].get_legend()
+            self.assertIsNotNone(legend, name)
+            self.assertIn(mess.INVALID_FIT_LABEL, [t.get_text() for t in legend.get_texts()])
+        # The energy-density figure draws no parabola for the invalid field and says so.
+        ax = figures["energy_density_fit.png"].axes[0]
+        labels = [t.get_text() for t in ax.get_legend().get_texts()]
+        self.assertTrue(any(t.endswith("no valid fit") for t in labels), labels)
+        curves = [ln for ln in ax.get_lines() if ln.get_marker() in ("None", "", None)
+                  and len(ln.get_xdata()) == 100]
+        self.assertEqual(len(curves), 3)  # 4 fields, one invalid
 
     def test_missing_steps_fails_with_one_line(self):
         d = mess_fixtures.make_magnetostriction(self.dir("ms_broken"), positions=None)

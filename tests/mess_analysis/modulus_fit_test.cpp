@@ -158,13 +158,124 @@ TEST(MessModulusFit, KinkBeforeThirdPointFitsAllPoints) {
   EXPECT_EQ(fit.points, 4u);
 }
 
-TEST(MessModulusFit, TwoPointsInterpolate) {
+TEST(MessModulusFit, TwoPointsAreNotAResult) {
+  // Two points interpolate a and c exactly, with nothing left to check the parabola: the
+  // numbers are kept (for marked plots) but the fit is invalid.
   const std::vector<double> x{0.0, 0.05};
   const auto fit = ma::fit_energy_density(x, parabola(x, kModulus, 7.0));
-  ASSERT_TRUE(fit.valid);
+  EXPECT_FALSE(fit.valid);
   EXPECT_EQ(fit.points, 2u);
+  EXPECT_NE(fit.problem.find("only 2 point(s)"), std::string::npos) << fit.problem;
   EXPECT_NEAR(fit.modulus, kModulus, 1e-9 * kModulus);
   EXPECT_NEAR(fit.offset, 7.0, 1e-9);
+}
+
+// Phi = 6 % at 140 mT (small example): three strains, the zero-strain point above the next is
+// dropped and two points remain. Before, 12.6 kPa was reported as G_eff.
+TEST(MessModulusFit, DroppedZeroPointLeavingTwoPointsIsInvalid) {
+  const std::vector<double> x{0.0, 0.02, 0.04};
+  auto u = parabola(x, kModulus, -100.0);
+  u[0] = u[1] + 1.0;
+  const auto fit = ma::fit_energy_density(x, u);
+  EXPECT_EQ(fit.first, 1U);
+  EXPECT_EQ(fit.points, 2U);
+  EXPECT_FALSE(fit.valid);
+  EXPECT_TRUE(std::isfinite(fit.modulus));
+  EXPECT_NE(fit.problem.find("at least 3"), std::string::npos) << fit.problem;
+}
+
+TEST(MessModulusFit, UnconvergedFittedPointIsInvalid) {
+  const auto x = strains(0.0, 0.01, 6);
+  const auto u = parabola(x, kModulus, 0.0);
+  ma::FitOptions options;
+  options.converged = {true, true, true, false, true, true};
+  const auto fit = ma::fit_energy_density(x, u, options);
+  EXPECT_FALSE(fit.valid);
+  EXPECT_NEAR(fit.modulus, kModulus, 1e-9 * kModulus);  // the numbers, for the marked plot
+  EXPECT_NE(fit.problem.find("strain 0.03 did not converge"), std::string::npos) << fit.problem;
+  // All converged: the same data is a result.
+  options.converged.assign(x.size(), true);
+  EXPECT_TRUE(ma::fit_energy_density(x, u, options).valid);
+  // Flags of another length are a programming error.
+  options.converged = {true};
+  EXPECT_THROW(ma::fit_energy_density(x, u, options), std::invalid_argument);
+}
+
+TEST(MessModulusFit, UnconvergedPointAfterTheKinkDoesNotMatter) {
+  // Only the fitted points count: the unconverged step lies behind the cut.
+  const auto x = strains(0.0, 0.01, 9);
+  auto u = parabola(x, kModulus, 0.0);
+  for (std::size_t i = 5; i < u.size(); ++i) u[i] -= 1.5;
+  ma::FitOptions options;
+  options.converged.assign(x.size(), true);
+  options.converged[7] = false;
+  const auto fit = ma::fit_energy_density(x, u, options);
+  EXPECT_TRUE(fit.split);
+  EXPECT_EQ(fit.points, 5U);
+  EXPECT_TRUE(fit.valid) << fit.problem;
+}
+
+TEST(MessModulusFit, NegativeCurvatureIsInvalid) {
+  // Energy falling with |x| away from zero strain (strains not starting at 0, so no point
+  // is compared with a zero-strain state): a < 0 is no modulus.
+  const auto x = strains(0.01, 0.01, 5);
+  const auto fit = ma::fit_energy_density(x, parabola(x, -kModulus, 50.0));
+  EXPECT_FALSE(fit.valid);
+  EXPECT_NEAR(fit.modulus, -kModulus, 1e-9 * kModulus);
+  EXPECT_NE(fit.problem.find("curvature"), std::string::npos) << fit.problem;
+}
+
+// Torsion of the helix: the +2 deg point lies below the zero-twist state (a torque at zero
+// twist); without the shear-only zero-point rule the symmetric parabola is refused.
+TEST(MessModulusFit, PointBelowTheZeroStrainStateIsInvalid) {
+  const double deg = 3.14159265358979 / 180.0;
+  const std::vector<double> x{0.0, 2 * deg, 4 * deg, 6 * deg};
+  std::vector<double> u;
+  for (const double xi : x) u.push_back(0.5 * kModulus * xi * xi - 600.0 * xi);  // linear term
+  ASSERT_LT(u[1], u[0]);
+  ma::FitOptions options;
+  options.drop_zero_point_above_next = false;
+  const auto fit = ma::fit_energy_density(x, u, options);
+  EXPECT_EQ(fit.first, 0U);
+  EXPECT_FALSE(fit.valid);
+  EXPECT_NE(fit.problem.find("below the zero-strain state"), std::string::npos) << fit.problem;
+  // Equal to the zero-strain state is not below it.
+  std::vector<double> flat = parabola(x, kModulus, 0.0);
+  EXPECT_TRUE(ma::fit_energy_density(x, flat, options).valid);
+}
+
+TEST(MessModulusFit, NonFiniteFittedPointIsInvalid) {
+  const auto x = strains(0.0, 0.01, 6);
+  auto u = parabola(x, kModulus, 0.0);
+  u[2] = std::numeric_limits<double>::quiet_NaN();
+  const auto fit = ma::fit_energy_density(x, u);
+  EXPECT_FALSE(fit.valid);
+  EXPECT_NE(fit.problem.find("non-finite"), std::string::npos) << fit.problem;
+  u[2] = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(ma::fit_energy_density(x, u).valid);
+}
+
+TEST(MessModulusFit, StressFitValidity) {
+  const std::vector<double> e{0.0, 0.01, 0.02, 0.03};
+  const std::vector<double> s{0.0, 90.0, 180.0, 270.0};
+  EXPECT_TRUE(ma::fit_stress_strain(e, s).valid);
+  // The both-faces stress run at 80 mT: a step hit its iteration limit.
+  const auto unconverged = ma::fit_stress_strain(e, s, {true, true, false, true});
+  EXPECT_FALSE(unconverged.valid);
+  EXPECT_NEAR(unconverged.modulus, 9000.0, 1e-9);
+  EXPECT_NE(unconverged.problem.find("stress 180 did not converge"), std::string::npos)
+      << unconverged.problem;
+  // One loaded point: a slope through the origin with nothing to check it.
+  const auto one = ma::fit_stress_strain({0.0, 0.01}, {0.0, 90.0});
+  EXPECT_FALSE(one.valid);
+  EXPECT_NE(one.problem.find("only 1 loaded point"), std::string::npos) << one.problem;
+  // Strain against the stress: a negative slope.
+  const auto negative = ma::fit_stress_strain({0.0, -0.01, -0.02}, {0.0, 90.0, 180.0});
+  EXPECT_FALSE(negative.valid);
+  EXPECT_NE(negative.problem.find("not positive"), std::string::npos) << negative.problem;
+  const auto nan = ma::fit_stress_strain({0.0, 0.01, std::numeric_limits<double>::quiet_NaN()},
+                                         {0.0, 90.0, 180.0});
+  EXPECT_FALSE(nan.valid);
 }
 
 TEST(MessModulusFit, UnderdeterminedIsInvalid) {

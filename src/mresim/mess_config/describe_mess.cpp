@@ -35,22 +35,6 @@ std::string with_thousands(std::int64_t n) {
 
 std::string placement_name(const MessSpec& s) { return lattice::to_string(s.placement_kind); }
 
-// Leapfrog stability limits dt < 2/omega_max of the seed lattice (reference-notes section 11).
-std::optional<double> leapfrog_limit(int discretization_order) {
-  switch (discretization_order) {
-    case 2:
-      return 4.8e-3;
-    case 3:
-      return 5.6e-3;
-    case 4:
-      return 5.7e-3;
-    case 5:
-      return 5.8e-3;
-    default:
-      return std::nullopt;
-  }
-}
-
 void describe_lattice(const MessSpec& s, app::InfoReport& r) {
   const MessGeometry& g = s.geometry;
   const std::string sec = "lattice";
@@ -310,7 +294,7 @@ void describe_solver(const MessSpec& s, app::InfoReport& r) {
         2.0 * std::numbers::pi * std::sqrt(l.polymer_density * l_e * l_e * l_e / k_eff);
     r.add_text(sec, "method", "leapfrog", "the seed's damped dynamics (reference)");
     std::string note = fmt::format("{:.6g} s", v.leapfrog.dt * t_c);
-    if (const auto limit = leapfrog_limit(l.discretization_order)) {
+    if (const auto limit = leapfrog_stability_limit(l.discretization_order)) {
       note += fmt::format("; seed stability limit about {:.2g} for n_d = {}", *limit,
                           l.discretization_order);
       if (v.leapfrog.dt >= *limit) note += " - EXCEEDED, expect blow-up";

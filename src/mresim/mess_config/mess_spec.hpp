@@ -136,6 +136,11 @@ struct LeapfrogSettings {
   double drag = 1.0;            // units of 1/t_c
 };
 
+// The seed profile's leapfrog stability limit dt < 2/omega_max in units of t_c for
+// discretization orders 2-5 (4.8e-3, 5.6e-3, 5.7e-3, 5.8e-3); std::nullopt for other orders,
+// where it is not known. The reader refuses leapfrog.dt at or above it (seed profile only).
+std::optional<double> leapfrog_stability_limit(int discretization_order);
+
 struct SolverSpec {
   SolverMethod method = SolverMethod::minimiser;
   MinimiserSettings minimiser;

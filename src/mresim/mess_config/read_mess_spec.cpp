@@ -6,9 +6,12 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
+#include "mresim/core/constants.hpp"
+#include "mresim/lattice/stiffness.hpp"
 #include "mresim/mess_config/array_reader.hpp"
 #include "mresim/mess_config/mess_spec.hpp"
 
@@ -632,9 +635,102 @@ void read_solver(const std::optional<TableReader>& solver, bool demagnetization,
   }
 }
 
+// ------------------------------------------------------------ scales that overflow (doubles)
+
+// The solvers sum squares of forces over every coordinate (minimiser norms, the leapfrog's
+// scaled accelerations) and products of energies; a force scale F is safe while
+// F^2 x 3 N x kHeadroom is a finite double (kHeadroom leaves room for strains, field and
+// particle-count factors far beyond any real run). Past it the relaxation produces inf/NaN;
+// such parameters are refused here instead.
+constexpr double kHeadroom = 1e10;
+
+// The largest force scale whose squares summed over `coordinates` stay finite (header above).
+double largest_scale(double coordinates) {
+  return std::sqrt(std::numeric_limits<double>::max() / (coordinates * kHeadroom));
+}
+
+// Refuses `key` of `table` (its value as written, or `fallback` when it is the default).
+[[noreturn]] void refuse(const TableReader& root, const char* table, const char* key,
+                         const std::string& fallback, const std::string& why) {
+  const auto t = root.optional_table(table);
+  if (!t) throw ConfigError(fmt::format("{}.{} = {}: {}", table, key, fallback, why));
+  t->fail(key, text_or(*t, key, fallback), why);
+}
+
+// Elastic force scale k_eff l_e (reference-notes section 2) and magnetic mu0 Ms^2 R^2 (the force
+// between two saturated particles at contact, eq. 4.71 over R; energy scale mu0 Ms^2 R^3).
+void check_scales(const TableReader& root, const MessSpec& s) {
+  const lattice::LatticeSpec& l = s.lattice;
+  const double l_e = s.geometry.element_length;
+  const double coordinates = 3.0 * static_cast<double>(s.geometry.node_count());
+  const double top = largest_scale(coordinates);
+  const lattice::LatticeStiffness k = lattice::polymer_stiffness(
+      l.profile, l.youngs_modulus, l.poisson_ratio, l_e, l.stiffness_ratio);
+  const double k_eff =
+      2.0 * k.springs.edge + 8.0 * k.springs.face / std::numbers::sqrt2 + 4.0 * k.springs.body;
+  const double elastic = k_eff * l_e;
+  const double smallest = std::sqrt(std::numeric_limits<double>::min() * kHeadroom);
+  if (!(elastic <= top && elastic >= smallest) || !std::isfinite(k.kappa * l_e * l_e * l_e)) {
+    refuse(
+        root, "model", "youngs_modulus", "9000 (default)",
+        fmt::format("gives the force scale k_eff l_e = {:.3g} N (elastic energy scale k_e "
+                    "l_e^2 = {:.3g} J) outside [{:.3g}, {:.3g}] N, where the solvers' sums of "
+                    "squares over the {} nodes stay finite doubles; use a physical modulus "
+                    "(the polymer's is of order 1e4 Pa)",
+                    elastic, k.springs.edge * l_e * l_e, smallest, top, s.geometry.node_count()));
+  }
+  if (s.geometry.particle_count() == 0) return;
+  const double ms = s.particles.Ms;
+  const double r = s.particles.radius;
+  const double magnetic = kMu0 * ms * ms * r * r;
+  // Also in the leapfrog's units of k_eff l_e (the scaled accelerations).
+  if (!(magnetic <= top) || !(magnetic / elastic <= top)) {
+    refuse(root, "particles", "saturation_magnetization", "1.6e6 (default)",
+           fmt::format("gives the magnetic force scale mu0 Ms^2 R^2 = {:.3g} N (energy scale "
+                       "mu0 Ms^2 R^3 = {:.3g} J), above {:.3g} N (or {:.3g} k_eff l_e), where the "
+                       "solvers' sums of squares stay finite doubles; iron's Ms is 1.6e6 A/m",
+                       magnetic, magnetic * r, top, top));
+  }
+}
+
+// The leapfrog is unstable for dt >= 2/omega_max of the lattice (reference-notes section 11);
+// omega_max is known for the seed profile at n_d = 2..5 (leapfrog_stability_limit).
+void check_leapfrog(const std::optional<TableReader>& solver, const MessSpec& s) {
+  if (s.solver.method != SolverMethod::leapfrog || s.lattice.profile != lattice::Profile::seed) {
+    return;
+  }
+  const auto limit = leapfrog_stability_limit(s.lattice.discretization_order);
+  if (!limit || s.solver.leapfrog.dt < *limit) return;
+  const auto leapfrog = solver->optional_table("leapfrog");
+  const std::string text =
+      leapfrog && leapfrog->has("dt") ? leapfrog->value_text("dt") : "0.005 (default)";
+  const std::string key = leapfrog ? leapfrog->path("dt") : solver->path("leapfrog.dt");
+  throw ConfigError(fmt::format(
+      "{} = {}: must be < {:.2g} (t_c) with profile = \"seed\" and discretization_order = {}: "
+      "the damped leapfrog is unstable above 2/omega_max of this lattice and its results "
+      "become non-finite",
+      key, text, *limit, s.lattice.discretization_order));
+}
+
 }  // namespace
 
 // ------------------------------------------------------------------------------------ public
+
+std::optional<double> leapfrog_stability_limit(int discretization_order) {
+  // reference-notes section 11: power iteration on the seed lattice's force Jacobian.
+  switch (discretization_order) {
+    case 2:
+      return 4.8e-3;
+    case 3:
+      return 5.6e-3;
+    case 4:
+      return 5.7e-3;
+    case 5:
+      return 5.8e-3;
+    default:
+      return std::nullopt;
+  }
+}
 
 std::string run_type_name(MessRunType type) {
   switch (type) {
@@ -748,6 +844,8 @@ MessSpec read_mess_spec(const TableReader& root, std::string_view run_type) {
   }
 
   read_solver(root.optional_table("solver"), s.demagnetization, s.solver);
+  check_scales(root, s);
+  check_leapfrog(root.optional_table("solver"), s);
   if (const auto t = root.optional_table("output")) {
     s.output.node_positions = t->boolean_or("node_positions", false);
     s.output.checkpoint_every = t->integer_or("checkpoint_every", 1, Range::between(0, 1e9));

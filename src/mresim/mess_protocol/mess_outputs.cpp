@@ -38,6 +38,8 @@ void write_step_positions(const fs::path& run_dir, std::size_t step,
 
 namespace {
 
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
 // VTK/XDMF hexahedron vertex order from the lattice's local order (vertex v at offset
 // ((v>>1)&1, (v>>2)&1, v&1), volume_elements.hpp): (000, 100, 110, 010, 001, 101, 111, 011).
 constexpr std::array<int, 8> kVtkOrder = {0, 2, 6, 4, 1, 3, 7, 5};
@@ -94,6 +96,13 @@ StepExtras step_extras(const ProtocolRunner& runner, const std::vector<StepRecor
     x.magnetization_projection.push_back(np > 0 ? (d.transpose() * r.magnetization).mean() / ms
                                                 : 0.0);
     x.energy_density.push_back(r.energies.total() / r.system_volume);
+    if (!r.centres.allFinite()) {  // no distances: NaN separation, cluster data -1
+      x.separation.push_back(kNaN);
+      x.cluster_count.push_back(-1);
+      x.largest_cluster.push_back(-1);
+      x.cluster_id.insert(x.cluster_id.end(), static_cast<std::size_t>(np), -1);
+      continue;
+    }
     x.separation.push_back(ma::min_separation(r.centres));
     const ma::Clusters c = ma::find_clusters(r.centres, contact);
     x.cluster_count.push_back(c.count);
@@ -110,77 +119,116 @@ std::string modulus_name(const mc::MessSpec& spec) {
   return "E_eff";
 }
 
-// Per field: the modulus from the steps at that field (Section 4.2.8).
-void write_analysis(const fs::path& run_dir, io::Hdf5File& results, const ProtocolRunner& runner,
-                    const std::vector<StepRecord>& records, const StepExtras& extras) {
-  const mc::MessSpec& spec = runner.spec();
-  const std::size_t fields = spec.field.values.size();
-  std::vector<double> magnitude;
-  std::vector<double> modulus;
-  std::vector<double> offset;
-  std::vector<double> rms;
-  std::vector<double> mr;
+// The modulus of every field (Section 4.2.8) with what the outputs say about its fit.
+struct FieldFits {
+  std::vector<double> magnitude;  // T
+  std::vector<double> modulus;    // Pa (J/m^3 torsion); NaN where underdetermined
+  std::vector<double> offset;     // J/m^3
+  std::vector<double> rms;        // J/m^3 or Pa
+  std::vector<double> mr;         // %
   std::vector<std::int64_t> first;
   std::vector<std::int64_t> points;
   std::vector<std::int64_t> split;
+  std::vector<std::int64_t> valid;
+  std::vector<std::int64_t> mr_valid;  // both this field's and the first field's fit are valid
+  std::vector<std::string> problem;    // "" where valid
+};
+
+FieldFits fit_fields(const mc::MessSpec& spec, const std::vector<StepRecord>& records,
+                     const StepExtras& extras) {
+  FieldFits out;
+  const std::size_t fields = spec.field.values.size();
   for (std::size_t f = 0; f < fields; ++f) {
     std::vector<double> strain;
     std::vector<double> density;
     std::vector<double> stress;
+    std::vector<bool> converged;
     for (std::size_t i = 0; i < records.size(); ++i) {
       if (records[i].step.field_index != f) continue;
       strain.push_back(records[i].measured_strain);
       density.push_back(extras.energy_density[i]);
       stress.push_back(records[i].step.load_value);
+      converged.push_back(records[i].converged);
     }
-    magnitude.push_back(spec.field.values[f].norm());
+    out.magnitude.push_back(spec.field.values[f].norm());
     if (spec.strain) {
-      const ma::QuadraticFit fit = ma::fit_energy_density(strain, density);
-      modulus.push_back(fit.valid ? fit.modulus : std::numeric_limits<double>::quiet_NaN());
-      offset.push_back(fit.offset);
-      rms.push_back(fit.rms_residual);
-      first.push_back(static_cast<std::int64_t>(fit.first));
-      points.push_back(static_cast<std::int64_t>(fit.points));
-      split.push_back(fit.split ? 1 : 0);
+      ma::FitOptions options;
+      // The original's zero-point rule is for shear (modulus_fit.hpp).
+      options.drop_zero_point_above_next = spec.strain->kind == mc::LoadKind::shear;
+      options.converged = converged;
+      const ma::QuadraticFit fit = ma::fit_energy_density(strain, density, options);
+      out.modulus.push_back(fit.modulus);
+      out.offset.push_back(fit.offset);
+      out.rms.push_back(fit.rms_residual);
+      out.first.push_back(static_cast<std::int64_t>(fit.first));
+      out.points.push_back(static_cast<std::int64_t>(fit.points));
+      out.split.push_back(fit.split ? 1 : 0);
+      out.valid.push_back(fit.valid ? 1 : 0);
+      out.problem.push_back(fit.problem);
     } else {
-      first.push_back(0);
-      const ma::LinearFit fit = ma::fit_stress_strain(strain, stress);
-      modulus.push_back(fit.valid ? fit.modulus : std::numeric_limits<double>::quiet_NaN());
-      offset.push_back(0.0);
-      rms.push_back(fit.rms_residual);
-      points.push_back(static_cast<std::int64_t>(fit.points));
-      split.push_back(0);
+      const ma::LinearFit fit = ma::fit_stress_strain(strain, stress, converged);
+      out.modulus.push_back(fit.modulus);
+      out.offset.push_back(0.0);
+      out.rms.push_back(fit.rms_residual);
+      out.first.push_back(0);
+      out.points.push_back(static_cast<std::int64_t>(fit.points));
+      out.split.push_back(0);
+      out.valid.push_back(fit.valid ? 1 : 0);
+      out.problem.push_back(fit.problem);
     }
   }
-  for (const double m : modulus) mr.push_back(ma::mr_effect_percent(m, modulus.front()));
+  for (std::size_t f = 0; f < fields; ++f) {
+    out.mr.push_back(ma::mr_effect_percent(out.modulus[f], out.modulus.front()));
+    out.mr_valid.push_back(out.valid[f] != 0 && out.valid.front() != 0 ? 1 : 0);
+  }
+  return out;
+}
 
+// /analysis and modulus.csv, one entry per field; invalid fits go to check.invalid_fits.
+void write_analysis(const fs::path& run_dir, io::Hdf5File& results, const ProtocolRunner& runner,
+                    const std::vector<StepRecord>& records, const StepExtras& extras,
+                    MessResultCheck& check) {
+  const mc::MessSpec& spec = runner.spec();
+  const FieldFits fits = fit_fields(spec, records, extras);
   const std::string name = modulus_name(spec);
+  for (std::size_t f = 0; f < fits.valid.size(); ++f) {
+    if (fits.valid[f] != 0) continue;
+    check.invalid_fits.push_back(fmt::format("{} at |B| = {:.4g} T (field {}): {}", name,
+                                             fits.magnitude[f], f, fits.problem[f]));
+  }
+
   const char* unit = name == "torsion_stiffness" ? "J/m^3" : "Pa";
   results.write_string_attribute("/analysis", "modulus_name", name);
   results.write_string_attribute("/analysis", "method",
                                  spec.strain ? "energy density = a x^2/2 + c, least squares"
                                              : "stress = a x, least squares through 0");
-  results.write_vector("/analysis/field_magnitude", magnitude, "T");
-  results.write_vector("/analysis/modulus", modulus, unit);
-  results.write_vector("/analysis/offset", offset, "J/m^3");
-  results.write_vector("/analysis/rms_residual", rms, spec.strain ? "J/m^3" : "Pa");
-  results.write_int_vector("/analysis/first_point", first);
-  results.write_int_vector("/analysis/fit_points", points);
-  results.write_int_vector("/analysis/split", split);
-  results.write_vector("/analysis/mr_effect", mr, "%");
+  results.write_vector("/analysis/field_magnitude", fits.magnitude, "T");
+  results.write_vector("/analysis/modulus", fits.modulus, unit);
+  results.write_vector("/analysis/offset", fits.offset, "J/m^3");
+  results.write_vector("/analysis/rms_residual", fits.rms, spec.strain ? "J/m^3" : "Pa");
+  results.write_int_vector("/analysis/first_point", fits.first);
+  results.write_int_vector("/analysis/fit_points", fits.points);
+  results.write_int_vector("/analysis/split", fits.split);
+  results.write_int_vector("/analysis/valid", fits.valid);
+  results.write_string_vector("/analysis/problem", fits.problem);
+  results.write_vector("/analysis/mr_effect", fits.mr, "%");
+  results.write_int_vector("/analysis/mr_effect_valid", fits.mr_valid);
 
   io::CsvWriter csv(
       run_dir / "modulus.csv",
       {"field_index", "B_T", name + (name == "torsion_stiffness" ? "_J_m3" : "_Pa"), "offset_J_m3",
-       "rms_residual", "first_point", "fit_points", "mr_effect_percent"});
-  for (std::size_t f = 0; f < fields; ++f) {
-    csv.row({static_cast<double>(f), magnitude[f], modulus[f], offset[f], rms[f],
-             static_cast<double>(first[f]), static_cast<double>(points[f]), mr[f]});
+       "residual", "first_point", "points", "valid", "mr_effect_percent", "mr_effect_valid"});
+  for (std::size_t f = 0; f < fits.magnitude.size(); ++f) {
+    csv.row({static_cast<double>(f), fits.magnitude[f], fits.modulus[f], fits.offset[f],
+             fits.rms[f], static_cast<double>(fits.first[f]), static_cast<double>(fits.points[f]),
+             static_cast<double>(fits.valid[f]), fits.mr[f],
+             static_cast<double>(fits.mr_valid[f])});
   }
 }
 
 void write_summary(const fs::path& run_dir, const std::vector<StepRecord>& records,
-                   const StepExtras& x, const char* load_unit) {
+                   const StepExtras& x, const std::vector<std::int64_t>& valid,
+                   const char* load_unit) {
   std::vector<std::string> columns = {
       "step",           "field_index", "load_index", "Bx_T",
       "By_T",           "Bz_T",        "B_along_T",  std::string("load_") + load_unit,
@@ -188,7 +236,7 @@ void write_summary(const fs::path& run_dir, const std::vector<StepRecord>& recor
   for (const EnergyTerm& t : energy_terms()) columns.push_back(std::string("E_") + t.name + "_J");
   for (const char* c :
        {"E_total_J", "energy_density_J_m3", "system_volume_m3", "M_along_Ms", "min_separation_m",
-        "clusters", "converged", "iterations", "max_force_N", "wall_time_s"}) {
+        "clusters", "converged", "valid", "iterations", "max_force_N", "wall_time_s"}) {
     columns.emplace_back(c);
   }
   io::CsvWriter csv(run_dir / "summary.csv", columns);
@@ -207,7 +255,8 @@ void write_summary(const fs::path& run_dir, const std::vector<StepRecord>& recor
     row.insert(row.end(), {r.energies.total(), x.energy_density[i], r.system_volume,
                            x.magnetization_projection[i], x.separation[i],
                            static_cast<double>(x.cluster_count[i]), r.converged ? 1.0 : 0.0,
-                           static_cast<double>(r.iterations), r.max_force, r.wall_time});
+                           static_cast<double>(valid[i]), static_cast<double>(r.iterations),
+                           r.max_force, r.wall_time});
     csv.row(row);
   }
 }
@@ -250,13 +299,93 @@ void write_xdmf(const fs::path& run_dir, const ProtocolRunner& runner,
 
 }  // namespace
 
-void write_mess_results(const fs::path& run_dir, io::Hdf5File& results,
-                        const ProtocolRunner& runner, const std::vector<StepRecord>& records) {
+std::string MessResultCheck::message() const {
+  std::string out;
+  if (non_finite.any()) out = non_finite.message("written as NaN; see /steps/valid in results.h5");
+  if (unconverged.any()) {
+    if (!out.empty()) out += "; ";
+    out += unconverged.message("see /steps/solver/converged and /steps/valid in results.h5");
+  }
+  return out;
+}
+
+namespace {
+
+// "step 3 (B = 0.04 T, load 0.02 rad)" (the load only for strain and stress runs).
+std::string step_place(const mc::MessSpec& spec, const StepRecord& r) {
+  const double b = r.step.field.dot(field_direction(spec));
+  if (!spec.strain && !spec.stress) return fmt::format("step {} (B = {:.4g} T)", r.step.index, b);
+  return fmt::format("step {} (B = {:.4g} T, load {:.4g} {})", r.step.index, b, r.step.load_value,
+                     load_unit(spec));
+}
+
+// The non-finite quantities of a step, comma-separated ("" when all are finite).
+std::string non_finite_quantities(const StepRecord& r) {
+  std::vector<std::string> bad;
+  bool energy = std::isfinite(r.energies.total());
+  for (const EnergyTerm& t : energy_terms())
+    energy = energy && std::isfinite(r.energies.*(t.member));
+  if (!energy) bad.emplace_back("energy");
+  if (!std::isfinite(r.system_volume)) bad.emplace_back("system volume");
+  if (!std::isfinite(r.measured_strain)) bad.emplace_back("measured strain");
+  if (!r.centres.allFinite()) bad.emplace_back("particle centres");
+  if (!r.magnetization.allFinite()) bad.emplace_back("magnetization");
+  if (!std::isfinite(r.max_force)) bad.emplace_back("max force");
+  if (!std::isfinite(r.magnetization_residual)) bad.emplace_back("magnetization residual");
+  std::string out;
+  for (const std::string& b : bad) out += (out.empty() ? "" : ", ") + b;
+  return out;
+}
+
+void nan_if_not_finite(double& v) {
+  if (!std::isfinite(v)) v = kNaN;
+}
+
+}  // namespace
+
+std::vector<std::int64_t> check_steps(const mc::MessSpec& spec,
+                                      const std::vector<StepRecord>& records,
+                                      MessResultCheck& check) {
+  std::vector<std::int64_t> valid;
+  valid.reserve(records.size());
+  for (const StepRecord& r : records) {
+    const std::string bad = non_finite_quantities(r);
+    if (!bad.empty()) {
+      check.non_finite.flag(bad, step_place(spec, r));
+    } else if (!r.converged) {
+      check.unconverged.flag(fmt::format("relaxation ({})", r.status), step_place(spec, r));
+    }
+    valid.push_back(bad.empty() && r.converged ? 1 : 0);
+  }
+  return valid;
+}
+
+std::vector<StepRecord> with_nan_for_non_finite(std::vector<StepRecord> records) {
+  for (StepRecord& r : records) {
+    for (const EnergyTerm& t : energy_terms()) nan_if_not_finite(r.energies.*(t.member));
+    nan_if_not_finite(r.system_volume);
+    nan_if_not_finite(r.measured_strain);
+    nan_if_not_finite(r.max_force);
+    nan_if_not_finite(r.magnetization_residual);
+    for (Eigen::Matrix3Xd* m : {&r.centres, &r.magnetization}) {
+      *m = m->unaryExpr([](double v) { return std::isfinite(v) ? v : kNaN; });
+    }
+  }
+  return records;
+}
+
+MessResultCheck write_mess_results(const fs::path& run_dir, io::Hdf5File& results,
+                                   const ProtocolRunner& runner,
+                                   const std::vector<StepRecord>& computed) {
   const mc::MessSpec& spec = runner.spec();
   const char* unit = load_unit(spec);
+  MessResultCheck check;
+  const std::vector<std::int64_t> valid = check_steps(spec, computed, check);
+  const std::vector<StepRecord> records = with_nan_for_non_finite(computed);
   write_lattice(results, runner);
   const std::size_t np = runner.system().particle_count();
   write_step_records(results, "/steps", records, np, unit);
+  results.write_int_vector("/steps/valid", valid);
   const StepExtras x = step_extras(runner, records);
   const Eigen::Vector3d d = field_direction(spec);
   results.write_vector("/steps/field_direction", {d.x(), d.y(), d.z()}, "1");
@@ -267,9 +396,10 @@ void write_mess_results(const fs::path& run_dir, io::Hdf5File& results,
   results.write_int_vector("/steps/cluster_count", x.cluster_count);
   results.write_int_vector("/steps/largest_cluster", x.largest_cluster);
   results.write_int_array("/steps/cluster_id", {records.size(), np}, x.cluster_id);
-  write_summary(run_dir, records, x, unit);
-  if (spec.strain || spec.stress) write_analysis(run_dir, results, runner, records, x);
+  write_summary(run_dir, records, x, valid, unit);
+  if (spec.strain || spec.stress) write_analysis(run_dir, results, runner, records, x, check);
   if (spec.output.node_positions) write_xdmf(run_dir, runner, records);
+  return check;
 }
 
 }  // namespace mresim::mess_protocol

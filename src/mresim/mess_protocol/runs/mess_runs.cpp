@@ -11,7 +11,9 @@
 #include <memory>
 #include <string>
 
+#include "mresim/app/invalid_results.hpp"
 #include "mresim/app/run_type.hpp"
+#include "mresim/app/stop_signal.hpp"
 #include "mresim/mess_config/mess_spec.hpp"
 #include "mresim/mess_protocol/checkpoint.hpp"
 #include "mresim/mess_protocol/mess_outputs.hpp"
@@ -55,26 +57,35 @@ class MessPlan final : public app::RunPlan {
         write_checkpoint(checkpoint, s, runner, input_toml_, input_name_);
       }
       progress.advance();
+      // SIGINT/SIGTERM: a step boundary is the safe point; checkpoint (whatever checkpoint_every
+      // says) so that `mresim resume` continues from here.
+      if (app::stop_requested() && s.next_step < total) {
+        write_checkpoint(checkpoint, s, runner, input_toml_, input_name_);
+        throw app::Interrupted(app::stop_signal(), true,
+                               fmt::format("after step {} of {}", s.next_step, total));
+      }
     });
 
-    write_mess_results(staging_dir, results, runner, state.records);
-    warn_about_unconverged(state.records);
+    const MessResultCheck check = write_mess_results(staging_dir, results, runner, state.records);
+    warn_about_intermediate_solves(state.records);
+    for (const std::string& fit : check.invalid_fits) {
+      std::cerr << "mresim: warning: invalid modulus fit, not a result: " << fit
+                << " (marked in /analysis/valid and modulus.csv)\n";
+    }
     std::error_code ec;
     fs::remove(checkpoint, ec);  // the results hold everything now
+    // Non-finite or unconverged steps: the results stay, marked; `mresim run` exits with 4.
+    const std::string invalid = check.message();
+    if (!invalid.empty()) throw app::InvalidResults(invalid);
   }
 
  private:
-  static void warn_about_unconverged(const std::vector<StepRecord>& records) {
-    std::size_t relaxation = 0;
+  // A magnetization solve that missed its tolerance during a step whose final solve converged
+  // leaves a valid step; it is reported, not an error.
+  static void warn_about_intermediate_solves(const std::vector<StepRecord>& records) {
     std::size_t magnetization = 0;
     for (const StepRecord& r : records) {
-      if (!r.converged) ++relaxation;
       if (r.unconverged_magnetization_solves > 0) ++magnetization;
-    }
-    if (relaxation > 0) {
-      std::cerr << fmt::format(
-          "mresim: warning: {} of {} steps did not converge (see /steps/solver in results.h5)\n",
-          relaxation, records.size());
     }
     if (magnetization > 0) {
       std::cerr << fmt::format(
