@@ -113,8 +113,8 @@ INSTANTIATE_TEST_SUITE_P(
                  with("type = \"pair_hysteresis\"", "type = \"pair_ensemble\"") +
                      "[ensemble]\nseparation_values = [2e-6, 9e-6]\nmean = 5e-6\n"
                      "standard_deviation = 1e-6\n",
-                 "ensemble.separation_min = 2e-06: every separation must be > 2R = 3e-06 m (the "
-                 "spheres would overlap)"}),
+                 "ensemble.separation_values = 2e-06: every separation must be > 2R = 3e-06 m "
+                 "(the spheres would overlap)"}),
     [](const auto& info) { return info.param.name; });
 
 // Through the command line: exit status 2, the message on stderr, and no output directory.

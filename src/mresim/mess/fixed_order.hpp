@@ -13,6 +13,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "mresim/core/parallel_exceptions.hpp"
+
 namespace mresim::mess::detail {
 
 inline constexpr std::int64_t kSumBlock = 4096;
@@ -26,13 +28,17 @@ double fixed_order_sum(std::int64_t n, Term&& term) {
   if (n <= 0) return 0.0;
   const std::int64_t blocks = (n + kSumBlock - 1) / kSumBlock;
   std::vector<double> partial(static_cast<std::size_t>(blocks), 0.0);
+  ParallelExceptions errors;  // `term` may throw; no exception may leave the region
 #pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
   for (std::int64_t b = 0; b < blocks; ++b) {
-    const std::int64_t end = (b + 1) * kSumBlock < n ? (b + 1) * kSumBlock : n;
-    double s = 0.0;
-    for (std::int64_t i = b * kSumBlock; i < end; ++i) s += term(i);
-    partial[static_cast<std::size_t>(b)] = s;
+    errors.run([&] {
+      const std::int64_t end = (b + 1) * kSumBlock < n ? (b + 1) * kSumBlock : n;
+      double s = 0.0;
+      for (std::int64_t i = b * kSumBlock; i < end; ++i) s += term(i);
+      partial[static_cast<std::size_t>(b)] = s;
+    });
   }
+  errors.rethrow();
   double total = 0.0;
   for (const double s : partial) total += s;
   return total;
@@ -44,17 +50,21 @@ std::array<double, 2> fixed_order_sums(std::int64_t n, Term&& term) {
   if (n <= 0) return {0.0, 0.0};
   const std::int64_t blocks = (n + kSumBlock - 1) / kSumBlock;
   std::vector<std::array<double, 2>> partial(static_cast<std::size_t>(blocks));
+  ParallelExceptions errors;
 #pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
   for (std::int64_t b = 0; b < blocks; ++b) {
-    const std::int64_t end = (b + 1) * kSumBlock < n ? (b + 1) * kSumBlock : n;
-    std::array<double, 2> s{0.0, 0.0};
-    for (std::int64_t i = b * kSumBlock; i < end; ++i) {
-      const std::array<double, 2> t = term(i);
-      s[0] += t[0];
-      s[1] += t[1];
-    }
-    partial[static_cast<std::size_t>(b)] = s;
+    errors.run([&] {
+      const std::int64_t end = (b + 1) * kSumBlock < n ? (b + 1) * kSumBlock : n;
+      std::array<double, 2> s{0.0, 0.0};
+      for (std::int64_t i = b * kSumBlock; i < end; ++i) {
+        const std::array<double, 2> t = term(i);
+        s[0] += t[0];
+        s[1] += t[1];
+      }
+      partial[static_cast<std::size_t>(b)] = s;
+    });
   }
+  errors.rethrow();
   std::array<double, 2> total{0.0, 0.0};
   for (const auto& s : partial) {
     total[0] += s[0];

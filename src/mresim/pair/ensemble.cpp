@@ -6,6 +6,8 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "mresim/core/parallel_exceptions.hpp"
+
 namespace mresim::pair {
 
 std::vector<double> gaussian_weights(const std::vector<double>& separations, double mean,
@@ -40,11 +42,15 @@ EnsembleResult ensemble_average(const std::vector<PairSystem>& members,
   EnsembleResult result;
   result.members.resize(members.size());
   const auto count = static_cast<long>(members.size());
+  ParallelExceptions errors;
 #pragma omp parallel for schedule(dynamic, 1)
   for (long i = 0; i < count; ++i) {
-    result.members[static_cast<std::size_t>(i)] =
-        magnetization_loop(run_hysteresis(members[static_cast<std::size_t>(i)], sweep));
+    errors.run([&] {
+      result.members[static_cast<std::size_t>(i)] =
+          magnetization_loop(run_hysteresis(members[static_cast<std::size_t>(i)], sweep));
+    });
   }
+  errors.rethrow();
   result.average = result.members.front();
   std::fill(result.average.magnetization.begin(), result.average.magnetization.end(), 0.0);
   for (std::size_t i = 0; i < members.size(); ++i) {

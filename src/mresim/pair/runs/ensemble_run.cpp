@@ -3,6 +3,8 @@
 // widening Delta(M/Ms)(H) and the differential susceptibility.
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 
 #include "mresim/app/run_type.hpp"
@@ -23,10 +25,19 @@ class EnsemblePlan final : public app::RunPlan {
     mean_ = e.number("mean", Range::positive(), "m");
     sd_ = e.number("standard_deviation", Range::positive(), "m");
     smoothing_ = e.choice_or("smoothing", "five_point", {"five_point", "none"}) == "five_point";
-    for (const PairSetup& c : cases_) {
-      for (double s0 : separations_) require_separable(e, "separation_min", s0, c.material);
-    }
+    for (const PairSetup& c : cases_)
+      require_separations(e, "separation", separations_, c.material);
+    check_weights(e);
     weights_ = gaussian_weights(separations_, mean_, sd_);
+    const std::string key =
+        e.has("separation_values") ? "ensemble.separation_values" : "ensemble.separation_min";
+    for (std::size_t c = 0; c < cases_.size(); ++c) {
+      const std::string w = wca_cutoff_warning(
+          cases_.size() == 1 ? key : fmt::format("case[{}] ({}): {}", c, cases_[c].label, key),
+          separations_, cases_[c]);
+      if (!w.empty()) warnings_.push_back(w);
+    }
+    print_warnings(warnings_);
   }
 
   void describe(app::InfoReport& report) const override {
@@ -48,8 +59,9 @@ class EnsemblePlan final : public app::RunPlan {
   void execute(const std::filesystem::path& staging_dir, io::Hdf5File& h5,
                app::Progress& progress) const override {
     progress.set_total(cases_.size());
-    io::CsvWriter summary(staging_dir / "summary.csv",
-                          {"case", "label", "step", "branch", "B_T", "M_over_Ms", "dM_dB_per_T"});
+    app::ResultCheck check("non-finite results");
+    io::CsvWriter summary(staging_dir / "summary.csv", {"case", "label", "step", "branch", "B_T",
+                                                        "M_over_Ms", "dM_dB_per_T", "valid"});
     io::CsvWriter widening_csv(staging_dir / "widening.csv",
                                {"case", "label", "B_T", "dM_over_Ms", "dM_over_Ms_smoothed"});
     for (std::size_t c = 0; c < cases_.size(); ++c) {
@@ -60,11 +72,18 @@ class EnsemblePlan final : public app::RunPlan {
       const LoopWidening widening = loop_widening(r.average);
       const std::vector<double> smooth = five_point_average(widening.widening);
       const MagnetizationLoop& loop = r.average;
+      std::vector<std::int64_t> valid;
       for (std::size_t i = 0; i < loop.field.size(); ++i) {
+        const std::string where = fmt::format("case {} ({}), step {} (B = {:.6g} T)", c,
+                                              cases_[c].label, i, loop.field[i]);
+        const bool ok = check.finite(loop.magnetization[i], "average M/Ms", where) &&
+                        check.finite(chi[i], "dM/dB", where);
+        valid.push_back(ok ? 1 : 0);
         summary.row_cells({static_cast<double>(c), cases_[c].label, static_cast<double>(i),
                            static_cast<double>(loop.branch[i]), loop.field[i],
-                           loop.magnetization[i], chi[i]});
+                           loop.magnetization[i], chi[i], ok ? 1.0 : 0.0});
       }
+      h5.write_int_vector(fmt::format("/cases/{}/valid", c), valid);
       for (std::size_t i = 0; i < widening.field.size(); ++i) {
         widening_csv.row_cells({static_cast<double>(c), cases_[c].label, widening.field[i],
                                 widening.widening[i], smooth[i]});
@@ -72,6 +91,9 @@ class EnsemblePlan final : public app::RunPlan {
       write_hdf5(h5, c, r, chi, widening, smooth);
       progress.advance();
     }
+    write_warnings_attribute(h5, warnings_);
+    check.throw_if_any(
+        "written as NaN; see /cases/<i>/valid in results.h5 and the valid column of summary.csv");
   }
 
  private:
@@ -98,12 +120,31 @@ class EnsemblePlan final : public app::RunPlan {
     h5.write_vector(g + "/members/weights", weights_, "1");
   }
 
+  // The Gaussian exp(-(S0 - mean)^2 / (2 sd^2)) must not vanish (underflow to 0) at every
+  // member, or the normalised weights are 0/0: typically mean or sd given in um, not m.
+  void check_weights(const config::TableReader& e) const {
+    for (const double s0 : separations_) {
+      const double z = (s0 - mean_) / sd_;
+      if (std::exp(-0.5 * z * z) > 0.0) return;
+    }
+    const double lo = separations_.front();
+    const double hi = separations_.back();
+    const bool mean_outside = mean_ < std::min(lo, hi) || mean_ > std::max(lo, hi);
+    const std::string what = fmt::format(
+        "the Gaussian weights exp(-(S0 - mean)^2 / (2 sd^2)) with mean = {} m, "
+        "standard_deviation = {} m vanish at every separation from {:.6g} to {:.6g} m; mean and "
+        "standard_deviation are in metres (4.8 um is 4.8e-6), like the separations",
+        mean_, sd_, lo, hi);
+    e.fail(mean_outside ? "mean" : "standard_deviation", mean_outside ? mean_ : sd_, what);
+  }
+
   std::vector<PairSetup> cases_;
   std::vector<double> separations_;
   double mean_ = 0.0;
   double sd_ = 0.0;
   bool smoothing_ = true;
   std::vector<double> weights_;
+  std::vector<std::string> warnings_;  // read-time warnings, also in results.h5 /@warnings
 };
 
 const app::RunTypeRegistrar registrar({"pair_ensemble",

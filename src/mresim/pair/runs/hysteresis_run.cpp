@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "mresim/app/run_type.hpp"
+#include "mresim/core/parallel_exceptions.hpp"
 #include "mresim/pair/runs/pair_outputs.hpp"
 
 namespace mresim::pair::runs {
@@ -13,7 +14,17 @@ namespace {
 
 class HysteresisPlan final : public app::RunPlan {
  public:
-  explicit HysteresisPlan(const config::TableReader& root) : cases_(read_pair_cases(root)) {}
+  explicit HysteresisPlan(const config::TableReader& root) : cases_(read_pair_cases(root)) {
+    const bool has_cases = !root.table_list("case").empty();
+    for (std::size_t i = 0; i < cases_.size(); ++i) {
+      const std::string key =
+          has_cases ? fmt::format("case[{}] ({}): springs.rest_separation", i, cases_[i].label)
+                    : std::string("springs.rest_separation");
+      const std::string w = wca_cutoff_warning(key, {cases_[i].rest_separation}, cases_[i]);
+      if (!w.empty()) warnings_.push_back(w);
+    }
+    print_warnings(warnings_);
+  }
 
   void describe(app::InfoReport& report) const override {
     report.add_integer("run", "cases", static_cast<std::int64_t>(cases_.size()));
@@ -30,17 +41,22 @@ class HysteresisPlan final : public app::RunPlan {
     std::vector<HysteresisLoop> loops(cases_.size());
     std::vector<CriticalFields> fields(cases_.size());
     const auto count = static_cast<long>(cases_.size());
+    ParallelExceptions errors;
 #pragma omp parallel for schedule(dynamic, 1)
     for (long i = 0; i < count; ++i) {
-      const auto c = static_cast<std::size_t>(i);
-      const PairSystem system = cases_[c].system();
-      loops[c] = run_hysteresis(system, cases_[c].sweep);
-      CriticalFieldOptions options;
-      options.tolerance = cases_[c].critical_field_tolerance;
-      fields[c] = find_critical_fields(system, loops[c], options);
-      progress.advance(loops[c].states.size());
+      errors.run([&] {
+        const auto c = static_cast<std::size_t>(i);
+        const PairSystem system = cases_[c].system();
+        loops[c] = run_hysteresis(system, cases_[c].sweep);
+        CriticalFieldOptions options;
+        options.tolerance = cases_[c].critical_field_tolerance;
+        fields[c] = find_critical_fields(system, loops[c], options);
+        progress.advance(loops[c].states.size());
+      });
     }
+    errors.rethrow();
 
+    app::ResultCheck check("non-finite results");
     io::CsvWriter summary(staging_dir / "summary.csv", loop_csv_columns());
     io::CsvWriter critical(
         staging_dir / "critical_fields.csv",
@@ -50,6 +66,8 @@ class HysteresisPlan final : public app::RunPlan {
       append_loop_rows(summary, c, cases_[c], loops[c]);
       write_loop_hdf5(results, group, cases_[c], cases_[c].system(), loops[c]);
       write_critical_fields_hdf5(results, group + "/critical_fields", fields[c]);
+      check_loop(check, c, cases_[c], loops[c]);
+      check_critical_fields(check, fmt::format("case {} ({})", c, cases_[c].label), fields[c]);
       critical.row_cells({static_cast<double>(c), cases_[c].label, fields[c].hysteresis ? 1.0 : 0.0,
                           fields[c].hc1, fields[c].hc2, fields[c].delta(), fields[c].uncertainty});
       if (const std::size_t bad = unconverged_states(loops[c]); bad > 0) {
@@ -60,6 +78,9 @@ class HysteresisPlan final : public app::RunPlan {
       }
     }
     results.write_int_attribute("/cases", "count", static_cast<std::int64_t>(cases_.size()));
+    write_warnings_attribute(results, warnings_);
+    check.throw_if_any(
+        "written as NaN; see /cases/<i>/valid in results.h5 and the valid column of summary.csv");
   }
 
  private:
@@ -69,6 +90,7 @@ class HysteresisPlan final : public app::RunPlan {
   }
 
   std::vector<PairSetup> cases_;
+  std::vector<std::string> warnings_;  // read-time warnings, also in results.h5 /@warnings
 };
 
 const app::RunTypeRegistrar registrar({"pair_hysteresis",

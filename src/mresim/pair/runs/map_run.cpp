@@ -3,6 +3,7 @@
 // with the eq. 2.10 threshold alongside for k maps.
 #include <fmt/format.h>
 
+#include <cmath>
 #include <memory>
 
 #include "mresim/app/run_type.hpp"
@@ -31,7 +32,15 @@ class MapPlan final : public app::RunPlan {
       rows_ = read_grid_axis(map, "row", Range::between(0.0, 90.0), "deg", "linear");
     }
     separations_ = read_grid_axis(map, "separation", Range::positive(), "m", "linear");
-    for (double s0 : separations_) require_separable(map, "separation_min", s0, base_.material);
+    require_separations(map, "separation", separations_, base_.material);
+    if (row_parameter_ == "k") check_k_rows(map);
+    PairSetup first = base_;  // the zero-field state depends on k, not on the angle
+    if (row_parameter_ == "k") first.stiffness = {StiffnessSource::Kind::spring_constant, rows_[0]};
+    const std::string w = wca_cutoff_warning(
+        map.has("separation_values") ? "map.separation_values" : "map.separation_min", separations_,
+        first);
+    if (!w.empty()) warnings_.push_back(w);
+    print_warnings(warnings_);
   }
 
   void describe(app::InfoReport& report) const override {
@@ -86,24 +95,34 @@ class MapPlan final : public app::RunPlan {
              const CriticalFieldGrid& grid) const {
     const std::size_t rows = rows_.size();
     const std::size_t cols = separations_.size();
-    io::CsvWriter csv(dir / "summary.csv", {"row", "col", "row_value", "S0_m", "hysteresis",
-                                            "HC1_T", "HC2_T", "dH_T", "k12_N_per_m", "k0_N_per_m"});
+    io::CsvWriter csv(dir / "summary.csv",
+                      {"row", "col", "row_value", "S0_m", "hysteresis", "HC1_T", "HC2_T", "dH_T",
+                       "k12_N_per_m", "k0_N_per_m", "valid"});
     std::vector<double> hc1;
     std::vector<double> hc2;
     std::vector<double> dh;
     std::vector<std::int64_t> hysteresis;
+    std::vector<double> valid;
+    app::ResultCheck check("non-finite results");
     for (std::size_t r = 0; r < rows; ++r) {
       for (std::size_t c = 0; c < cols; ++c) {
         const CriticalFields& f = grid.at(r, c);
         const PairSystem p = point(r, c).system;
+        const bool ok = std::isfinite(f.hc1) && std::isfinite(f.hc2);
+        check_critical_fields(
+            check, fmt::format("row {}, col {} (S0 = {:.6g} m)", r, c, separations_[c]), f);
         csv.row({static_cast<double>(r), static_cast<double>(c), rows_[r], separations_[c],
-                 f.hysteresis ? 1.0 : 0.0, f.hc1, f.hc2, f.delta(), p.springs.k12, p.springs.k0});
+                 f.hysteresis ? 1.0 : 0.0, f.hc1, f.hc2, f.delta(), p.springs.k12, p.springs.k0,
+                 ok ? 1.0 : 0.0});
         hc1.push_back(f.hc1);
         hc2.push_back(f.hc2);
         dh.push_back(f.delta());
         hysteresis.push_back(f.hysteresis ? 1 : 0);
+        valid.push_back(ok ? 1.0 : 0.0);
       }
     }
+    h5.write_array("/map/valid", {rows, cols}, valid, "1");
+    write_warnings_attribute(h5, warnings_);
     h5.write_string_attribute("/map", "row_parameter", row_parameter_);
     h5.write_number_attribute("/map", "critical_field_uncertainty_T",
                               0.5 * base_.critical_field_tolerance);
@@ -123,12 +142,32 @@ class MapPlan final : public app::RunPlan {
       }
       h5.write_vector("/map/eq_2_10_threshold", s0_max, "m");
     }
+    check.throw_if_any(
+        "written as NaN; see /map/valid in results.h5 and the valid column of "
+        "summary.csv");
+  }
+
+  // The spring constants of the rows in the solver's units (k R^2 / mu0 Ms^2 V) and the spring
+  // energy scale k S0^2 must be finite.
+  void check_k_rows(const config::TableReader& map) const {
+    const double r = base_.material.radius;
+    const double scale = base_.material.magnetic_energy_scale();
+    const double s0 = separations_.back();
+    for (const double k : rows_) {
+      if (!std::isfinite(k * r * r / scale) || !std::isfinite(k * s0 * s0)) {
+        map.fail(map.has("row_values") ? "row_values" : "row_max", k,
+                 fmt::format("gives the spring energy scale k S0^2 = {:.3g} J, which overflows "
+                             "next to the magnetic energy scale mu0 Ms^2 V = {:.3g} J",
+                             k * s0 * s0, scale));
+      }
+    }
   }
 
   std::string row_parameter_;
   PairSetup base_;
   std::vector<double> rows_;
   std::vector<double> separations_;
+  std::vector<std::string> warnings_;  // read-time warnings, also in results.h5 /@warnings
 };
 
 const app::RunTypeRegistrar registrar({"pair_map",

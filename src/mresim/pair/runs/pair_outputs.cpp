@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
+#include <iostream>
 
 #include "mresim/pair/overlap_penalty.hpp"
 #include "mresim/pair/stiffness.hpp"
@@ -10,10 +12,11 @@
 namespace mresim::pair::runs {
 
 std::vector<std::string> loop_csv_columns() {
-  return {"case",      "step",       "branch",     "B_T",         "S_m",        "S_minus_S0_m",
-          "theta_deg", "m1_x",       "m1_y",       "m1_z",        "m2_x",       "m2_y",
-          "m2_z",      "M_over_Ms",  "saturated",  "E_total_J",   "E_zeeman_J", "E_dipole_J",
-          "E_self_J",  "E_spring_J", "E_anchor_J", "E_penalty_J", "iterations", "converged"};
+  return {"case",         "step",        "branch",     "B_T",       "S_m",
+          "S_minus_S0_m", "theta_deg",   "m1_x",       "m1_y",      "m1_z",
+          "m2_x",         "m2_y",        "m2_z",       "M_over_Ms", "saturated",
+          "E_total_J",    "E_zeeman_J",  "E_dipole_J", "E_self_J",  "E_spring_J",
+          "E_anchor_J",   "E_penalty_J", "iterations", "converged", "valid"};
 }
 
 void append_loop_rows(io::CsvWriter& csv, std::size_t case_index, const PairSetup& setup,
@@ -46,7 +49,8 @@ void append_loop_rows(io::CsvWriter& csv, std::size_t case_index, const PairSetu
              e.anchor,
              e.penalty,
              static_cast<double>(s.iterations),
-             s.converged ? 1.0 : 0.0});
+             s.converged ? 1.0 : 0.0,
+             state_is_finite(s) ? 1.0 : 0.0});
   }
 }
 
@@ -65,6 +69,7 @@ void write_loop_hdf5(io::Hdf5File& h5, const std::string& group, const PairSetup
   std::vector<std::int64_t> iterations;
   std::vector<std::int64_t> converged;
   std::vector<std::int64_t> saturated;
+  std::vector<std::int64_t> valid;
   std::vector<std::vector<double>> terms(6);
   for (const PairState& s : loop.states) {
     field.push_back(s.field);
@@ -83,6 +88,7 @@ void write_loop_hdf5(io::Hdf5File& h5, const std::string& group, const PairSetup
     iterations.push_back(s.iterations);
     converged.push_back(s.converged ? 1 : 0);
     saturated.push_back(s.magnetization.saturated ? 1 : 0);
+    valid.push_back(state_is_finite(s) ? 1 : 0);
   }
   h5.write_string_attribute(group, "label", setup.label);
   h5.write_string_attribute(group, "spring_model",
@@ -108,6 +114,47 @@ void write_loop_hdf5(io::Hdf5File& h5, const std::string& group, const PairSetup
   h5.write_int_vector(group + "/solver/iterations", iterations);
   h5.write_int_vector(group + "/solver/converged", converged);
   h5.write_int_vector(group + "/saturated", saturated);
+  h5.write_int_vector(group + "/valid", valid);
+}
+
+bool state_is_finite(const PairState& s) {
+  const EnergyBreakdown& e = s.energy;
+  return s.separation.allFinite() && s.magnetization.m.allFinite() && std::isfinite(s.field) &&
+         std::isfinite(e.zeeman) && std::isfinite(e.dipole) && std::isfinite(e.self) &&
+         std::isfinite(e.spring) && std::isfinite(e.anchor) && std::isfinite(e.penalty);
+}
+
+void check_loop(app::ResultCheck& check, std::size_t case_index, const PairSetup& setup,
+                const HysteresisLoop& loop) {
+  for (std::size_t i = 0; i < loop.states.size(); ++i) {
+    const PairState& s = loop.states[i];
+    if (state_is_finite(s)) continue;
+    const std::string where =
+        fmt::format("case {} ({}), step {} (B = {:.6g} T)", case_index, setup.label, i, s.field);
+    if (!s.separation.allFinite()) {
+      check.flag("separation", where);
+    } else if (!s.magnetization.m.allFinite()) {
+      check.flag("moment", where);
+    } else {
+      check.flag("energy", where);
+    }
+  }
+}
+
+void check_critical_fields(app::ResultCheck& check, const std::string& where,
+                           const CriticalFields& f) {
+  check.finite(f.hc1, "HC1", where);
+  check.finite(f.hc2, "HC2", where);
+}
+
+void print_warnings(const std::vector<std::string>& warnings) {
+  for (const std::string& w : warnings) std::cerr << "mresim: warning: " << w << '\n';
+}
+
+void write_warnings_attribute(io::Hdf5File& h5, const std::vector<std::string>& warnings) {
+  std::string text;
+  for (const std::string& w : warnings) text += (text.empty() ? "" : "\n") + w;
+  h5.write_string_attribute("/", "warnings", text);
 }
 
 void write_critical_fields_hdf5(io::Hdf5File& h5, const std::string& group,
@@ -182,6 +229,55 @@ void describe_pair(app::InfoReport& report, const std::string& section, const Pa
                   sw.relax.method == RelaxMethod::newton
                       ? "Newton (polar coordinates, exact gradient)"
                       : "nonlinear conjugate gradients (Section 2.4, reference)");
+}
+
+// Zero-field equilibrium along the axis: m = 0 at B = 0 (linear law), so only the springs and
+// the penalty act: (k12 + k0/2)(S - S0) + dP/dS = 0 (eqs. 2.3-2.4, the anchors after removing
+// the centre of mass), solved by bisection between S0 and where the penalty lets go.
+double zero_field_separation(const PairSystem& p) {
+  const double s0 = p.springs.rest_separation;
+  const double k =
+      p.springs.k12 + (p.springs.model == SpringModel::three ? 0.5 * p.springs.k0 : 0.0);
+  auto force = [&](double s) {
+    return k * (s - s0) + overlap_penalty(p.penalty, p.material.radius, s).derivative;
+  };
+  const double f0 = force(s0);
+  if (f0 == 0.0) return s0;
+  // Pushed out: the root lies in (S0, r_cut] (at r_cut itself if the force jumps there).
+  // Pulled in (the attractive tail of a WCA with r_cut past its minimum): in [r_lj, S0).
+  double lo = f0 < 0.0 ? s0 : std::pow(2.0, 1.0 / 6.0) * p.penalty.r_min;
+  double hi = f0 < 0.0 ? std::max(s0, p.penalty.r_cut) : s0;
+  if (f0 < 0.0 && force(hi) < 0.0) return hi;
+  for (int i = 0; i < 200 && hi - lo > 1e-15 * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (force(mid) < 0.0 ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+std::string wca_cutoff_warning(const std::string& key, const std::vector<double>& separations,
+                               const PairSetup& setup) {
+  if (setup.penalty.kind != PenaltyKind::wca) return {};
+  std::vector<double> inside;
+  for (const double s0 : separations) {
+    if (s0 < setup.penalty.r_cut) inside.push_back(s0);
+  }
+  if (inside.empty()) return {};
+  const double used = zero_field_separation(setup.system_at(inside.front()));
+  if (std::abs(used - inside.front()) <= 1e-9 * inside.front()) return {};
+  std::string given = fmt::format("{} = {:.6g} m lies", key, inside.front());
+  if (separations.size() > 1 && inside.size() == 1) {
+    given = fmt::format("{}: 1 of the {} separations ({:.6g} m) lies", key, separations.size(),
+                        inside.front());
+  } else if (separations.size() > 1) {
+    given = fmt::format("{}: {} of the {} separations ({:.6g} ... {:.6g} m) lie", key,
+                        inside.size(), separations.size(), inside.front(), inside.back());
+  }
+  return fmt::format(
+      "{} inside the WCA cut-off penalty.r_cut = {:.6g} m, where the penalty acts: at zero field "
+      "the pair sits at S = {:.6g} m instead of S0 = {:.6g} m{}",
+      given, setup.penalty.r_cut, used, inside.front(),
+      inside.size() == 1 ? "" : " (the first of them)");
 }
 
 std::size_t unconverged_states(const HysteresisLoop& loop) {

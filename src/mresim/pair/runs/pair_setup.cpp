@@ -2,8 +2,14 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <numbers>
+#include <utility>
 
+#include "mresim/core/constants.hpp"
+#include "mresim/pair/overlap_penalty.hpp"
 #include "mresim/pair/stiffness.hpp"
 
 namespace mresim::pair::runs {
@@ -63,6 +69,12 @@ PairSystem PairSetup::system_at(double s0) const {
 }
 
 namespace {
+
+// Lengths handled by the solver in units of R are squared and raised to the 7th power (the
+// dipole gradient); beyond this ratio to R their squares approach the largest double.
+constexpr double kMaxReducedLength = 1e100;
+constexpr double kSmallest = std::numeric_limits<double>::min();
+constexpr double kLargest = std::numeric_limits<double>::max();
 
 const std::vector<std::string> kStiffnessKeys{"k", "k0", "k12", "shear_modulus", "youngs_modulus"};
 
@@ -161,6 +173,114 @@ void read_field(const TableReader& t, SweepOptions& sweep) {
   }
 }
 
+// Fails on `table`.`key` of `scope`, naming the full dotted key even when `scope` does not
+// contain that table (a [[case]] inheriting the value from the root).
+[[noreturn]] void fail_in(const TableReader& scope, const std::string& table,
+                          const std::string& key, double value, const std::string& what) {
+  if (scope.has(table)) scope.table(table).fail(key, value, what);
+  const std::string prefix = scope.path().empty() ? "" : scope.path() + ".";
+  throw config::ConfigError(fmt::format("{}{}.{} = {}: {}", prefix, table, key, value, what));
+}
+
+// A positive, finite double that is not subnormal (and not 0 after underflow).
+bool normal_positive(double x) { return std::isfinite(x) && x >= kSmallest; }
+
+// The energy unit mu0 Ms^2 V and the length unit R of the solver (pair_energy.hpp) must be
+// normal doubles, or every reduced quantity becomes 0, inf or NaN.
+void validate_material_scales(const TableReader& scope, const SphereMaterial& m) {
+  const double shape = 4.0 / 3.0 * std::numbers::pi;
+  const double v = m.volume();
+  if (!normal_positive(v)) {
+    fail_in(scope, "material", "radius", m.radius,
+            fmt::format("gives the sphere volume V = 4/3 pi R^3 = {:.3g} m^3, outside the range "
+                        "of doubles; R must lie in [{:.3g}, {:.3g}] m",
+                        v, std::cbrt(kSmallest / shape), std::cbrt(kLargest / shape)));
+  }
+  const double scale = m.magnetic_energy_scale();
+  if (!normal_positive(scale)) {
+    fail_in(scope, "material", "saturation_magnetization", m.saturation_magnetization,
+            fmt::format("gives the magnetic energy scale mu0 Ms^2 V = {:.3g} J, outside the range "
+                        "of doubles; at R = {:.6g} m Ms must lie in [{:.3g}, {:.3g}] A/m",
+                        scale, m.radius, std::sqrt(kSmallest / std::min(v, 1.0)) / std::sqrt(kMu0),
+                        std::sqrt(kLargest / std::max(v, 1.0)) / std::sqrt(kMu0)));
+  }
+}
+
+// The key that sets the spring constants, for messages.
+std::string stiffness_key(const StiffnessSource& s) {
+  switch (s.kind) {
+    case StiffnessSource::Kind::spring_constant:
+      return "k";
+    case StiffnessSource::Kind::three_spring_constants:
+      return "k12";
+    case StiffnessSource::Kind::shear_modulus:
+      return "shear_modulus";
+    case StiffnessSource::Kind::youngs_modulus:
+      return "youngs_modulus";
+  }
+  return "k";
+}
+
+// The spring energy scale k S0^2 and the spring constants in solver units k R^2 / (mu0 Ms^2 V).
+void validate_spring_scales(const TableReader& scope, const PairSetup& s, const PairSystem& p) {
+  const double scale = p.material.magnetic_energy_scale();
+  const double r = p.material.radius;
+  const std::string key = stiffness_key(s.stiffness);
+  const double value = s.stiffness.kind == StiffnessSource::Kind::spring_constant ? s.stiffness.k
+                       : s.stiffness.kind == StiffnessSource::Kind::three_spring_constants
+                           ? s.stiffness.k12
+                           : s.stiffness.modulus;
+  for (const double k : {p.springs.k12, p.springs.k0}) {
+    const double energy = k * s.rest_separation * s.rest_separation;
+    if (!std::isfinite(k) || !std::isfinite(energy) || !std::isfinite(k * r * r / scale)) {
+      fail_in(scope, "springs", key, value,
+              fmt::format("gives the spring constant {:.3g} N/m and the spring energy scale "
+                          "k S0^2 = {:.3g} J, which overflow next to the magnetic energy scale "
+                          "mu0 Ms^2 V = {:.3g} J",
+                          k, energy, scale));
+    }
+  }
+}
+
+// Field, penalty and springs in the solver's units (lengths in R, energies in mu0 Ms^2 V).
+void validate_reduced_scales(const TableReader& scope, const PairSetup& s) {
+  const SphereMaterial& m = s.material;
+  const double scale = m.magnetic_energy_scale();
+  const double h = reduced_field(s.sweep.b_max, m.saturation_magnetization);
+  if (!std::isfinite(h) || !std::isfinite(2.0 * h * scale)) {
+    fail_in(scope, "field", "max", s.sweep.b_max,
+            fmt::format("gives the reduced field H/Ms = {:.3g} and the field energy scale "
+                        "2 mu0 Ms H V = {:.3g} J, which overflow",
+                        h, 2.0 * h * scale));
+  }
+  const OverlapPenalty& p = s.penalty;
+  if (!std::isfinite(p.e_max / scale)) {
+    fail_in(scope, "penalty", "e_max", p.e_max,
+            fmt::format("is {:.3g} times the magnetic energy scale mu0 Ms^2 V = {:.3g} J, which "
+                        "overflows",
+                        p.e_max / scale, scale));
+  }
+  if (p.kind == PenaltyKind::tanh) {
+    const double slope = p.e_max / (scale * p.delta * m.radius);  // dE/dS at u = 0, solver units
+    if (!std::isfinite(slope) || !normal_positive(p.delta * m.radius)) {
+      fail_in(scope, "penalty", "delta", p.delta,
+              fmt::format("gives the barrier slope E_max / (delta R) = {:.3g} mu0 Ms^2 V / R, "
+                          "which overflows",
+                          slope));
+    }
+  } else {
+    for (const auto& [key, length] : {std::pair{"r_min", p.r_min}, std::pair{"r_cut", p.r_cut}}) {
+      if (length > kMaxReducedLength * m.radius || !normal_positive(length / m.radius)) {
+        fail_in(scope, "penalty", key, length,
+                fmt::format("must lie in [{:.3g}, {:.3g}] m (lengths are computed in units of R "
+                            "and raised to the 12th power relative to each other)",
+                            kSmallest * m.radius, kMaxReducedLength * m.radius));
+      }
+    }
+  }
+  validate_spring_scales(scope, s, s.system());
+}
+
 }  // namespace
 
 PairSetup read_pair_setup(const TableReader& scope, const PairSetup& base, bool is_root,
@@ -226,13 +346,34 @@ void require_separable(const TableReader& table, const std::string& key, double 
   }
 }
 
+void require_separations(const TableReader& table, const std::string& axis,
+                         const std::vector<double>& separations, const SphereMaterial& material) {
+  const bool listed = table.has(axis + "_values");
+  for (const double s0 : separations) {
+    require_separable(table, listed ? axis + "_values" : axis + "_min", s0, material);
+    if (s0 > kMaxReducedLength * material.radius) {
+      table.fail(listed ? axis + "_values" : axis + "_max", listed ? s0 : separations.back(),
+                 fmt::format("every separation must be <= {:.0e} R = {:.6g} m (lengths are "
+                             "computed in units of R and squared)",
+                             kMaxReducedLength, kMaxReducedLength * material.radius));
+    }
+  }
+}
+
 void validate_pair(const TableReader& scope, const PairSetup& s) {
+  validate_material_scales(scope, s.material);
   const double contact = 2.0 * s.material.radius;
   if (s.rest_separation <= contact) {
-    const TableReader springs = scope.has("springs") ? scope.table("springs") : scope;
-    springs.fail("rest_separation", s.rest_separation,
-                 fmt::format("must be > 2R = {:.6g} m (the spheres would overlap)", contact));
+    fail_in(scope, "springs", "rest_separation", s.rest_separation,
+            fmt::format("must be > 2R = {:.6g} m (the spheres would overlap)", contact));
   }
+  if (s.rest_separation > kMaxReducedLength * s.material.radius) {
+    fail_in(scope, "springs", "rest_separation", s.rest_separation,
+            fmt::format("must be <= {:.0e} R = {:.6g} m (lengths are computed in units of R "
+                        "and squared)",
+                        kMaxReducedLength, kMaxReducedLength * s.material.radius));
+  }
+  validate_reduced_scales(scope, s);
   if (s.penalty.kind == PenaltyKind::wca && s.penalty.r_cut <= s.penalty.r_min) {
     const TableReader penalty = scope.has("penalty") ? scope.table("penalty") : scope;
     penalty.fail("r_cut", s.penalty.r_cut,

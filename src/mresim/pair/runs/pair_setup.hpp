@@ -2,6 +2,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "mresim/config/table_reader.hpp"
 #include "mresim/pair/hysteresis.hpp"
@@ -54,7 +55,14 @@ std::vector<PairSetup> read_pair_cases(const config::TableReader& root);
 void require_separable(const config::TableReader& table, const std::string& key, double s0,
                        const SphereMaterial& material);
 
-// Validation of the assembled pair (S0 > 2R, WCA r_cut > r_min, ...), naming the key at fault.
+// Checks the separations of a map or ensemble axis ("separation" -> separation_min/_max or
+// separation_values): every one > 2R and <= 1e100 R (the solver squares lengths in units of R).
+void require_separations(const config::TableReader& table, const std::string& axis,
+                         const std::vector<double>& separations, const SphereMaterial& material);
+
+// Validation of the assembled pair (S0 > 2R, WCA r_cut > r_min, ...), naming the key at fault,
+// including the scales of the solver's units: R^3, mu0 Ms^2 V, the reduced field, spring and
+// penalty constants must be finite normal doubles (otherwise the results would be NaN).
 void validate_pair(const config::TableReader& scope, const PairSetup& setup);
 
 }  // namespace mresim::pair::runs
