@@ -17,12 +17,14 @@ struct RunOptions {
   std::string out;    // empty: ./<run file stem>
   long threads = -1;  // -1: take [run].threads
   bool no_plot = false;
+  bool force = false;  // move an unrecognised existing --out aside instead of refusing
 };
 CLI::App* add_run_command(CLI::App& app, RunOptions& options);
 int run_command(const RunOptions& options);
 
 // Shared by run and resume: executes the plan into run_dir's staging directory (results.h5
-// with the run's metadata), commits it and draws the figures. Returns the exit status.
+// with the run's metadata), commits it and draws the figures. Returns the exit status; a stop
+// signal (stop_signal.hpp) ends it with 128 + the signal after keeping any checkpoint.
 int execute_and_publish(const config::TableReader& root, const app::RunPlan& plan,
                         const std::string& run_type, io::RunDirectory& run_dir, long threads_option,
                         bool no_plot);
@@ -51,6 +53,9 @@ int plot_command(const PlotOptions& options);
 
 CLI::App* add_types_command(CLI::App& app);
 int types_command();
+
+// The --threads option of run and resume: an integer in [0, app::max_threads()].
+void add_threads_option(CLI::App& command, long& threads);
 
 // "  name   summary" lines for every registered run type.
 std::string run_type_list();

@@ -3,12 +3,15 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <mresim/core/version.hpp>
+#include <new>
 #include <string>
 
 #include "cli/commands.hpp"
 #include "cli/exit_status.hpp"
+#include "mresim/app/stop_signal.hpp"
 #include "mresim/config/config_error.hpp"
 #include "mresim/io/run_directory.hpp"
 
@@ -31,7 +34,8 @@ int run_cli(int argc, char** argv) {
   app.require_subcommand(1);
   app.footer(
       "Exit status: 0 success; 1 the run failed (nothing was written); 2 invalid run file,\n"
-      "command line or --out (nothing was done); 3 results written but drawing figures failed.");
+      "command line or --out (nothing was done); 3 results written but drawing figures failed;\n"
+      "4 results written but some are invalid (marked); 130/143 stopped by SIGINT/SIGTERM.");
 
   RunOptions run_options;
   InfoOptions info_options;
@@ -42,6 +46,24 @@ int run_cli(int argc, char** argv) {
   CLI::App* info = add_info_command(app, info_options);
   CLI::App* plot = add_plot_command(app, plot_options);
   CLI::App* types = add_types_command(app);
+
+  // CLI11 would take an unknown command for a stray argument and, with --help, print the main
+  // help and succeed: a typo must fail instead.
+  if (argc > 1 && argv[1][0] != '-') {
+    bool known = false;
+    std::string names;
+    for (const CLI::App* command : app.get_subcommands({})) {
+      known |= command->check_name(argv[1]);
+      names += (names.empty() ? "" : ", ") + command->get_name();
+    }
+    if (!known) {
+      std::fprintf(stderr,
+                   "mresim: error: unknown command '%s'; commands: %s\nRun 'mresim --help' for "
+                   "usage.\n",
+                   argv[1], names.c_str());
+      return kInvalidInput;
+    }
+  }
 
   try {
     app.parse(argc, argv);
@@ -57,6 +79,7 @@ int run_cli(int argc, char** argv) {
   }
 
   try {
+    if (*run || *resume) mresim::app::install_stop_handlers();
     if (*run) return run_command(run_options);
     if (*resume) return resume_command(resume_options);
     if (*info) return info_command(info_options);
@@ -66,6 +89,11 @@ int run_cli(int argc, char** argv) {
     return report_error(e.what(), kInvalidInput);
   } catch (const mresim::io::OutputDirectoryError& e) {
     return report_error(e.what(), kInvalidInput);
+  } catch (const std::bad_alloc&) {
+    return report_error(
+        "out of memory; the run needs more memory than this machine or job allows ('mresim info "
+        "FILE' prints the estimate for 3D runs)",
+        kFailure);
   } catch (const std::exception& e) {
     return report_error(e.what(), kFailure);
   }

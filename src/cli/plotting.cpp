@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "mresim/io/run_manifest.hpp"
+
 extern char** environ;  // NOLINT: POSIX global, passed on to the child
 
 namespace mresim::cli {
@@ -88,6 +90,33 @@ bool has_plot_modules(const std::string& python) {
   return r.started && r.exit_status == 0;
 }
 
+// The interpreter to draw with: the chosen one (MRESIM_PYTHON, else python3 on PATH) if it has
+// the plotting modules; else Debian's, which the README's packages install into. A python3
+// earlier on PATH (pyenv, conda, a virtualenv) often lacks them; that is no error as long as
+// some interpreter works, so nothing is said then. Empty if none works, after the message, with
+// `failure_status` set: 127 if the interpreter does not exist, 1 if it lacks the modules.
+std::string plotting_interpreter(int& failure_status) {
+  const std::string python = python_interpreter();
+  if (has_plot_modules(python)) return python;
+  const bool user_chose_python = std::getenv("MRESIM_PYTHON") != nullptr;
+  if (!user_chose_python && python != kSystemPython && std::filesystem::exists(kSystemPython) &&
+      has_plot_modules(kSystemPython)) {
+    return kSystemPython;
+  }
+  const ChildResult found = spawn_and_wait({python, "-c", "pass"}, true);
+  failure_status = found.started ? 1 : 127;
+  if (!found.started) {
+    std::fprintf(stderr, "mresim: error: %s was not found; %s\n", python.c_str(), kInstallHint);
+  } else {
+    // The commonest cause of a failed plot by far: say exactly what to install.
+    std::fprintf(stderr,
+                 "mresim: error: %s cannot import matplotlib, numpy and h5py; %s (or set "
+                 "MRESIM_PYTHON to a Python interpreter that has them)\n",
+                 python.c_str(), kInstallHint);
+  }
+  return "";
+}
+
 }  // namespace
 
 int draw_figures(const std::filesystem::path& run_dir) {
@@ -97,30 +126,15 @@ int draw_figures(const std::filesystem::path& run_dir) {
         "plot script '{}' not found; set MRESIM_PYTHON_DIR to the directory holding mresim_plot.py",
         script.string()));
   }
-  const bool user_chose_python = std::getenv("MRESIM_PYTHON") != nullptr;
-  const std::string python = python_interpreter();
+  int failure_status = 0;
+  const std::string python = plotting_interpreter(failure_status);
+  if (python.empty()) return failure_status;
+  const auto started = std::filesystem::file_time_type::clock::now();
   const ChildResult plot = spawn_and_wait({python, script.string(), run_dir.string()}, false);
-  if (plot.started && plot.exit_status == 0) return 0;
-
-  const bool modules_found = plot.started && has_plot_modules(python);
-  if (!modules_found && !user_chose_python && python != kSystemPython &&
-      std::filesystem::exists(kSystemPython) && has_plot_modules(kSystemPython)) {
-    // A python3 earlier on PATH (pyenv, conda, a virtualenv) often lacks the Debian packages
-    // the README installs; the system interpreter has them.
-    std::fprintf(stderr, "mresim: note: %s lacks matplotlib, numpy or h5py; using %s\n",
-                 python.c_str(), kSystemPython);
-    return spawn_and_wait({kSystemPython, script.string(), run_dir.string()}, false).exit_status;
-  }
-  if (!plot.started) {
-    std::fprintf(stderr, "mresim: error: %s was not found; %s\n", python.c_str(), kInstallHint);
-  } else if (!modules_found) {
-    // The commonest cause of a failed plot by far: say exactly what to install.
-    std::fprintf(stderr,
-                 "mresim: error: %s cannot import matplotlib, numpy and h5py; %s (or set "
-                 "MRESIM_PYTHON to a Python interpreter that has them)\n",
-                 python.c_str(), kInstallHint);
-  }
-  return plot.exit_status;
+  // The figures are mresim's files: list them in the run's manifest, so that a later run may
+  // replace the directory. Only what this plot wrote, never a file the user put there.
+  io::run_manifest::add_files_below(run_dir, "figures", started);
+  return plot.started ? plot.exit_status : 127;
 }
 
 }  // namespace mresim::cli

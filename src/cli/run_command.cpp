@@ -1,6 +1,8 @@
 // `mresim run FILE`: validate everything, then compute into a staging directory, commit it,
 // and draw the figures.
 
+#include <fmt/format.h>
+
 #include <cstdio>
 #include <filesystem>
 
@@ -9,6 +11,7 @@
 #include "cli/plotting.hpp"
 #include "mresim/app/invalid_results.hpp"
 #include "mresim/app/run_type.hpp"
+#include "mresim/app/stop_signal.hpp"
 #include "mresim/app/threads.hpp"
 #include "mresim/config/table_reader.hpp"
 #include "mresim/io/hdf5_file.hpp"
@@ -24,11 +27,13 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& options) {
   run->add_option("FILE", options.file, "Run file (TOML), see docs/run-files.md")->required();
   run->add_option("--out,-o", options.out,
                   "Output directory (default: ./<FILE without extension>). An earlier mresim "
-                  "run there is replaced; any other existing directory is refused");
-  run->add_option("--threads,-j", options.threads,
-                  "Number of threads; 0 = all cores (default: [run].threads, else all cores)")
-      ->check(CLI::NonNegativeNumber);
+                  "run there is replaced if it holds only the files mresim wrote; any other "
+                  "existing directory is refused");
+  add_threads_option(*run, options.threads);
   run->add_flag("--no-plot", options.no_plot, "Do not draw figures/*.png after the run");
+  run->add_flag("--force", options.force,
+                "Use --out even if it holds files mresim did not write: the old directory is "
+                "renamed to DIR.replaced-<time> when the run finishes, never deleted");
   run->footer("Run types in this build:\n" + run_type_list());
   return run;
 }
@@ -41,9 +46,49 @@ int run_command(const RunOptions& options) {
 
   // 2. Claim the output directory (refused if it holds something other than an mresim run).
   const fs::path out = options.out.empty() ? fs::path(options.file).stem() : fs::path(options.out);
-  io::RunDirectory run_dir(out);
+  io::RunDirectory run_dir(out, io::RunDirectory::Options{options.force});
 
   return execute_and_publish(root, *plan, run_type, run_dir, options.threads, options.no_plot);
+}
+
+namespace {
+
+// A stop signal ended the run: keep its checkpoint (if any) and say how to go on.
+int report_interrupted(const app::Interrupted& e, io::RunDirectory& run_dir) {
+  const std::string shown = run_dir.shown_path().string();
+  if (e.resumable) {
+    run_dir.keep_for_resume();
+    std::fprintf(stderr,
+                 "mresim: interrupted by %s %s; the checkpoint is in '%s'; continue with "
+                 "'mresim resume %s'\n",
+                 app::signal_name(e.signal).c_str(), e.what(), run_dir.path().string().c_str(),
+                 shown.c_str());
+  } else {
+    std::fprintf(stderr,
+                 "mresim: interrupted by %s %s; this run type writes no checkpoints, nothing was "
+                 "written to '%s'\n",
+                 app::signal_name(e.signal).c_str(), e.what(), shown.c_str());
+  }
+  return 128 + e.signal;
+}
+
+}  // namespace
+
+void add_threads_option(CLI::App& command, long& threads) {
+  command
+      .add_option("--threads,-j", threads,
+                  "Number of threads; 0 = all cores (default: [run].threads, else all cores)")
+      ->check(CLI::Validator(
+          [](std::string& value) -> std::string {
+            try {
+              std::size_t used = 0;
+              const long n = std::stol(value, &used);
+              if (used == value.size() && n >= 0 && n <= app::max_threads()) return "";
+            } catch (const std::exception&) {  // not a number, or out of long's range
+            }
+            return fmt::format("{}: {}", value, app::threads_allowed());
+          },
+          "INT", "threads"));
 }
 
 int execute_and_publish(const config::TableReader& root, const app::RunPlan& plan,
@@ -66,8 +111,12 @@ int execute_and_publish(const config::TableReader& root, const app::RunPlan& pla
     app::Progress progress(0, run_type);
     try {
       plan.execute(run_dir.path(), results, progress);
+      // Run types without checkpoints finish their computation, then stop here.
+      app::throw_if_stop_requested("before the results were published");
     } catch (const app::InvalidResults& e) {
       invalid_results = e.what();
+    } catch (const app::Interrupted& e) {
+      return report_interrupted(e, run_dir);
     }
     progress.finish();
     results.write_string_attribute("/", "invalid_results", invalid_results);
@@ -77,6 +126,10 @@ int execute_and_publish(const config::TableReader& root, const app::RunPlan& pla
   // 4. Publish the complete directory in one step.
   run_dir.commit();
   std::printf("mresim: results written to %s\n", out.string().c_str());
+  if (!run_dir.moved_aside().empty()) {
+    std::printf("mresim: the directory that was there (--force) is now %s\n",
+                run_dir.moved_aside().string().c_str());
+  }
   std::fflush(stdout);
   const int plot_status = no_plot ? kSuccess : draw_figures(run_dir.final_path());
   if (plot_status != kSuccess) {

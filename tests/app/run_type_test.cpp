@@ -57,12 +57,20 @@ TEST(RunTypes, ReportsProblemsInTheRunTable) {
   EXPECT_EQ(bad_type.rfind("run.type = \"tset_dummy\": must be one of ", 0), 0U) << bad_type;
   EXPECT_NE(bad_type.find("test_dummy"), std::string::npos);
   EXPECT_EQ(config_error_of("[run]\ntype = \"test_dummy\"\nthreads = -1\n[dummy]\nsteps = 1\n"),
-            "run.threads = -1: must be >= 0");
+            "run.threads = -1: " + threads_allowed());
+  // Far more threads than cores only slows a run down (and crashed the OpenMP runtime).
+  EXPECT_EQ(
+      config_error_of("[run]\ntype = \"test_dummy\"\nthreads = 1000000\n[dummy]\nsteps = 1\n"),
+      "run.threads = 1000000: " + threads_allowed());
+  EXPECT_EQ(read_run_settings(parse("[run]\ntype = \"test_dummy\"\nthreads = " +
+                                    std::to_string(max_threads()) + "\n"))
+                .threads,
+            max_threads());
 }
 
 TEST(RunTypes, RejectsUnknownKeysAfterTheRunTypeHasReadItsTables) {
   EXPECT_EQ(config_error_of("[run]\ntype = \"test_dummy\"\n[dummy]\nsteps = 1\nscael = 2\n"),
-            "unknown key 'dummy.scael' in [dummy]; allowed keys: fail_at, scale, steps");
+            "unknown key 'dummy.scael' in [dummy]; allowed keys: fail_at, nan_at, scale, step_seconds, steps");
   EXPECT_EQ(config_error_of("[run]\ntype = \"test_dummy\"\ntitel = \"x\"\n[dummy]\nsteps = 1\n"),
             "unknown key 'run.titel' in [run]; allowed keys: threads, title, type");
   EXPECT_EQ(config_error_of("[run]\ntype = \"test_dummy\"\n[dummy]\nsteps = 1\n[extra]\n"),

@@ -151,7 +151,8 @@ TEST(Cli, RunWritesACompleteRunDirectory) {
   EXPECT_NE(r.err.find("test_dummy: done 3/3"), std::string::npos) << r.err;
   // The default output directory is named after the run file; no staging directory remains.
   EXPECT_EQ(listing(dir.path()), (std::vector<std::string>{"demo", "demo.toml"}));
-  EXPECT_EQ(listing(dir / "demo"), (std::vector<std::string>{"results.h5", "summary.csv"}));
+  EXPECT_EQ(listing(dir / "demo"),
+            (std::vector<std::string>{".mresim-manifest", "results.h5", "summary.csv"}));
 
   const Hdf5Reader h5(dir / "demo" / "results.h5");
   EXPECT_EQ(h5.string_attribute("/", "run_type"), "test_dummy");
@@ -192,8 +193,8 @@ TEST(Cli, UnknownKeysAreRejectedBeforeAnythingIsWritten) {
   const Result r = testbed(dir.path(), "run typo.toml --out results");
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.err,
-            "mresim: error: unknown key 'dummy.scael' in [dummy]; allowed keys: fail_at, scale, "
-            "steps\n");
+            "mresim: error: unknown key 'dummy.scael' in [dummy]; allowed keys: fail_at, nan_at, "
+            "scale, step_seconds, steps\n");
   EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"typo.toml"});
 }
 
@@ -205,8 +206,9 @@ TEST(Cli, RefusesToOverwriteADirectoryThatIsNotARun) {
   const Result r = testbed(dir.path(), "run demo.toml --out data --no-plot");
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.err,
-            "mresim: error: output directory 'data' exists and is not an mresim run directory; "
-            "choose another --out\n");
+            "mresim: error: output directory 'data' exists and was not written by mresim (it has "
+            "no .mresim-manifest and holds 'keep.txt'); choose another --out, or add --force to "
+            "move it aside (it is renamed, never deleted)\n");
   EXPECT_EQ(listing(dir / "data"), std::vector<std::string>{"keep.txt"});
   EXPECT_EQ(listing(dir.path()), (std::vector<std::string>{"data", "demo.toml"}));
 }
@@ -331,17 +333,19 @@ TEST(Cli, PlotFallsBackToTheSystemPythonWhenPathHasOneWithoutMatplotlib) {
   fs::create_directories(dir / "run");
   write_text(dir / "run" / "results.h5", "");
   write_fake_plot_script(dir / "py", 0);
-  // A python3 first on PATH that can import nothing, as a bare virtualenv would.
+  // A python3 first on PATH that can import nothing, as a bare virtualenv would; it complains
+  // as Python does.
   fs::create_directories(dir / "bin");
-  write_text(dir / "bin" / "python3", "#!/bin/sh\nexit 1\n");
+  write_text(dir / "bin" / "python3",
+             "#!/bin/sh\necho \"ModuleNotFoundError: No module named 'matplotlib'\" >&2\nexit 1\n");
   fs::permissions(dir / "bin" / "python3", fs::perms::owner_all);
   const Result r = mresim(dir.path(), "plot run",
                           "env -u MRESIM_PYTHON PATH='" + (dir / "bin").string() +
                               ":/usr/bin:/bin' MRESIM_PYTHON_DIR='" + (dir / "py").string() + "'");
   EXPECT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.err.find("lacks matplotlib, numpy or h5py; using /usr/bin/python3"),
-            std::string::npos)
-      << r.err;
+  // Some interpreter works, so nothing is said about the one that does not.
+  EXPECT_EQ(r.err.find("No module named"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("error"), std::string::npos) << r.err;
   EXPECT_TRUE(fs::exists(dir / "run" / "figures" / "backend.txt"));
 }
 

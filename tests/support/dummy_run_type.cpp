@@ -8,13 +8,19 @@
 //   steps = 4         # integer >= 1
 //   scale = 0.5       # m, > 0 (default 1)
 //   fail_at = 2       # optional: throw at this step, to test cleanup
+//   nan_at = 1        # optional: this step's value is NaN (invalid results, exit status 4)
+//   step_seconds = 0.2  # optional: sleep this long per step (locks, signals)
 
 #include <omp.h>
 
+#include <chrono>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
+#include "mresim/app/invalid_results.hpp"
 #include "mresim/app/run_type.hpp"
 #include "mresim/io/csv_writer.hpp"
 
@@ -29,6 +35,8 @@ class DummyPlan final : public mresim::app::RunPlan {
     steps_ = dummy.integer("steps", Range::at_least(1));
     scale_ = dummy.number_or("scale", 1.0, Range::positive(), "m");
     fail_at_ = dummy.integer_or("fail_at", -1, Range::any());
+    nan_at_ = dummy.integer_or("nan_at", -1, Range::any());
+    step_seconds_ = dummy.number_or("step_seconds", 0.0, Range::between(0.0, 60.0), "s");
   }
 
   void describe(mresim::app::InfoReport& report) const override {
@@ -42,21 +50,28 @@ class DummyPlan final : public mresim::app::RunPlan {
     progress.set_total(static_cast<std::size_t>(steps_));
     std::vector<double> values;
     mresim::io::CsvWriter csv(staging_dir / "summary.csv", {"step", "value_m"});
+    mresim::app::ResultCheck check("non-finite results");
     for (long i = 0; i < steps_; ++i) {
       if (i == fail_at_) throw std::runtime_error("dummy failure at step " + std::to_string(i));
-      values.push_back(scale_ * static_cast<double>(i));
+      std::this_thread::sleep_for(std::chrono::duration<double>(step_seconds_));
+      values.push_back(i == nan_at_ ? std::numeric_limits<double>::quiet_NaN()
+                                    : scale_ * static_cast<double>(i));
+      check.finite(values.back(), "value", "step " + std::to_string(i));
       csv.row({static_cast<double>(i), values.back()});
       progress.advance();
     }
     csv.close();
     results.write_vector("/dummy/values", values, "m");
     results.write_int_attribute("/dummy", "threads", omp_get_max_threads());
+    check.throw_if_any("written as NaN");
   }
 
  private:
   long steps_ = 0;
   double scale_ = 1.0;
   long fail_at_ = -1;
+  long nan_at_ = -1;
+  double step_seconds_ = 0.0;
 };
 
 const mresim::app::RunTypeRegistrar registrar({"test_dummy", "Test-only run type",

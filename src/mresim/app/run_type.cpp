@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include "mresim/app/threads.hpp"
+
 namespace mresim::app {
 
 namespace {
@@ -50,7 +52,10 @@ RunSettings read_run_settings(const config::TableReader& root) {
   RunSettings settings;
   settings.type = run.choice("type", names);
   settings.title = run.string_or("title", "");
-  settings.threads = run.integer_or("threads", 0, config::Range::non_negative());
+  settings.threads = run.integer_or("threads", 0, config::Range::any());
+  if (settings.threads < 0 || settings.threads > max_threads()) {
+    run.fail("threads", run.value_text("threads"), threads_allowed());
+  }
   return settings;
 }
 

@@ -1,0 +1,144 @@
+// What `mresim run` guarantees about its output directory while other things happen: a second
+// run at the same time, a stop signal, results that are not valid numbers. Runs the test-bed
+// command (the real CLI plus the test-only run type test_dummy, whose `step_seconds` makes it
+// slow enough to interfere with).
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "../support/hdf5_read.hpp"
+#include "../support/temp_dir.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using mresim::testing::Hdf5Reader;
+using mresim::testing::read_text;
+using mresim::testing::TempDir;
+using mresim::testing::write_text;
+
+constexpr const char* kSlowRun =
+    "[run]\ntype = \"test_dummy\"\n[dummy]\nsteps = 20\nstep_seconds = 0.1\n";
+
+// `mresim_testbed args...` in `dir` in the background, stdout and stderr to files in `dir`.
+pid_t start(const fs::path& dir, const std::vector<std::string>& args, const std::string& tag) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    if (::chdir(dir.c_str()) != 0) ::_exit(127);
+    if (std::freopen((tag + ".out").c_str(), "w", stdout) == nullptr) ::_exit(127);
+    if (std::freopen((tag + ".err").c_str(), "w", stderr) == nullptr) ::_exit(127);
+    std::vector<char*> argv{const_cast<char*>("mresim")};
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    ::execv(MRESIM_TESTBED_PATH, argv.data());
+    ::_exit(127);
+  }
+  return pid;
+}
+
+int wait_for(pid_t pid) {
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+// Waits until `path` exists (the run has claimed its directory); false after 30 s.
+bool appears(const fs::path& path) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (fs::exists(path)) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return false;
+}
+
+std::vector<std::string> listing(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// Issue: two runs into one --out both printed "results written"; the later replaced the other.
+TEST(RunSafety, ASecondRunIntoARunningDirectoryIsRefusedNamingTheFirst) {
+  const TempDir dir;
+  write_text(dir / "slow.toml", kSlowRun);
+  write_text(dir / "fast.toml", "[run]\ntype = \"test_dummy\"\n[dummy]\nsteps = 1\n");
+  const pid_t first = start(dir.path(), {"run", "slow.toml", "--out", "out", "--no-plot"}, "first");
+  ASSERT_TRUE(appears(dir / "out.mresim-lock"));
+  const pid_t second =
+      start(dir.path(), {"run", "fast.toml", "--out", "out", "--no-plot"}, "second");
+  EXPECT_EQ(wait_for(second), 2);
+  const std::string err = read_text(dir / "second.err");
+  EXPECT_NE(err.find("mresim: error: output directory 'out' is in use by mresim run, pid " +
+                     std::to_string(first) + " on host"),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(read_text(dir / "second.out"), "");
+  EXPECT_EQ(wait_for(first), 0) << read_text(dir / "first.err");
+  EXPECT_EQ(Hdf5Reader(dir / "out" / "results.h5").doubles("/dummy/values").size(), 20U);
+  EXPECT_FALSE(fs::exists(dir / "out.mresim-lock"));
+}
+
+// SIGINT / SIGTERM: a run type without checkpoints stops, publishes nothing, removes what it
+// created (the parent directories of --out included) and exits with 128 + the signal.
+TEST(RunSafety, AStopSignalEndsARunWithoutCheckpointsLeavingNothing) {
+  for (const int signal : {SIGINT, SIGTERM}) {
+    const TempDir dir;
+    write_text(dir / "slow.toml", kSlowRun);
+    const pid_t pid =
+        start(dir.path(), {"run", "slow.toml", "--out", "new/parent/out", "--no-plot"}, "run");
+    ASSERT_TRUE(appears(dir / "new" / "parent" / "out.mresim-lock"));
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    ::kill(pid, signal);
+    EXPECT_EQ(wait_for(pid), 128 + signal);
+    const std::string err = read_text(dir / "run.err");
+    EXPECT_NE(err.find(std::string("mresim: interrupted by ") +
+                       (signal == SIGINT ? "SIGINT" : "SIGTERM") +
+                       " before the results were published; this run type writes no "
+                       "checkpoints, nothing was written to 'new/parent/out'"),
+              std::string::npos)
+        << err;
+    EXPECT_EQ(listing(dir.path()), (std::vector<std::string>{"run.err", "run.out", "slow.toml"}));
+  }
+}
+
+// Non-finite results are published with the bad entries marked, and the run fails (status 4).
+TEST(RunSafety, NonFiniteResultsAreKeptMarkedAndTheRunExitsWith4) {
+  const TempDir dir;
+  write_text(dir / "nan.toml", "[run]\ntype = \"test_dummy\"\n[dummy]\nsteps = 6\nnan_at = 2\n");
+  const pid_t pid = start(dir.path(), {"run", "nan.toml", "--out", "out", "--no-plot"}, "run");
+  EXPECT_EQ(wait_for(pid), 4);
+  const std::string err = read_text(dir / "run.err");
+  EXPECT_NE(err.find("mresim: error: non-finite results: value at step 2 (written as NaN); the "
+                     "results in 'out' are kept with these entries marked invalid"),
+            std::string::npos)
+      << err;
+  const Hdf5Reader h5(dir / "out" / "results.h5");
+  EXPECT_EQ(h5.string_attribute("/", "invalid_results"),
+            "non-finite results: value at step 2 (written as NaN)");
+  const std::vector<double> values = h5.doubles("/dummy/values");
+  ASSERT_EQ(values.size(), 6U);
+  EXPECT_TRUE(std::isnan(values[2]));
+  EXPECT_EQ(values[3], 3.0);
+}
+
+TEST(RunSafety, AValidRunRecordsThatNothingIsInvalid) {
+  const TempDir dir;
+  write_text(dir / "ok.toml", "[run]\ntype = \"test_dummy\"\n[dummy]\nsteps = 2\n");
+  const pid_t pid = start(dir.path(), {"run", "ok.toml", "--out", "out", "--no-plot"}, "run");
+  EXPECT_EQ(wait_for(pid), 0);
+  EXPECT_EQ(Hdf5Reader(dir / "out" / "results.h5").string_attribute("/", "invalid_results"), "");
+}
+
+}  // namespace
