@@ -107,7 +107,9 @@ INSTANTIATE_TEST_SUITE_P(
         Refused{"FarMapSeparation",
                 replaced(kMap, "separation_max = 12e-6", "separation_max = 1e200"),
                 "map.separation_max = 1e+200: every separation must be <= 1e+100 R"},
-        Refused{"HugeStiffness", replaced(kLoop, "k = 4e-2", "k = 1e300"),
+        Refused{"HugeStiffnessForTinySpheres",
+                replaced(kLoop, "k = 4e-2", "k = 1e300") +
+                    "[material]\nradius = 1e-100\n[penalty]\ntype = \"wca\"\n",
                 "springs.k = 1e+300: gives the spring constant 1e+300 N/m and the spring energy "
                 "scale k S0^2"},
         Refused{"HugePenalty", kLoop + "[penalty]\ne_max = 1e300\n",
