@@ -514,7 +514,7 @@ def _note_missing(ax, b_mt, ok, why):
             ax.set_xlim(finite.min(), finite.max())
         ax.text(0.5, 0.5, why, transform=ax.transAxes, ha="center", va="center", color="0.4")
     elif not np.all(ok):
-        ax.text(0.02, 0.02, f"{int(np.sum(~ok))} field(s) without a value: {why}",
+        ax.text(0.02, 0.02, f"{int(np.sum(~ok))} field(s) without a valid value: {why}",
                 transform=ax.transAxes, fontsize=8, color="0.4")
 
 

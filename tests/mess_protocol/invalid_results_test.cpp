@@ -160,6 +160,17 @@ TEST(MessInvalidResults, CheckStepsNamesNonFiniteAndUnconvergedSteps) {
   EXPECT_TRUE(std::isnan(written[1].centres(2, 1)));
   EXPECT_EQ(written[0].energies.springs, 0.0);
 
+  // Relaxation converged, the final magnetization solve did not: named as such.
+  records[3].converged = false;
+  records[3].magnetization_method = "newton";
+  records[3].magnetization_residual = 0.5;
+  MessResultCheck solve;
+  (void)check_steps(spec, {records[3]}, solve);
+  EXPECT_NE(solve.message().find("final magnetization solve (newton, residual 0.5 Ms) at step 3"),
+            std::string::npos)
+      << solve.message();
+  records[3].converged = true;
+
   MessResultCheck clean;
   (void)check_steps(spec, {records[0], records[3]}, clean);
   EXPECT_EQ(clean.message(), "");

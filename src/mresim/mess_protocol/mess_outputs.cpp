@@ -353,7 +353,13 @@ std::vector<std::int64_t> check_steps(const mc::MessSpec& spec,
     if (!bad.empty()) {
       check.non_finite.flag(bad, step_place(spec, r));
     } else if (!r.converged) {
-      check.unconverged.flag(fmt::format("relaxation ({})", r.status), step_place(spec, r));
+      // converged relaxation, unconverged final magnetization solve (protocol_runner.cpp)
+      const std::string what =
+          r.status == "converged"
+              ? fmt::format("final magnetization solve ({}, residual {:.3g} Ms)",
+                            r.magnetization_method, r.magnetization_residual)
+              : fmt::format("relaxation ({})", r.status);
+      check.unconverged.flag(what, step_place(spec, r));
     }
     valid.push_back(bad.empty() && r.converged ? 1 : 0);
   }
