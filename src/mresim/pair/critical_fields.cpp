@@ -1,37 +1,79 @@
 #include "mresim/pair/critical_fields.hpp"
 
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <optional>
 #include <utility>
 
 namespace mresim::pair {
+
+int bisection_limit(double range, double tolerance) {
+  if (!(range > tolerance) || !(tolerance > 0.0)) return 0;
+  const double halvings = std::ceil(std::log2(range / tolerance));
+  return static_cast<int>(std::min(halvings, 1100.0));
+}
+
 namespace {
 
 struct Bracket {
   double bistable_field;
-  Eigen::Vector3d rising_state;   // the separated (not yet clustered) branch
-  Eigen::Vector3d falling_state;  // the clustered branch
-  double single_field;            // a field where only one state exists
+  PairState rising_state;   // the separated (not yet clustered) branch
+  PairState falling_state;  // the clustered branch
+  double single_field;      // a field where only one state exists
 };
 
-// Bisects between a bistable field and a single-state field; returns the midpoint.
-double refine(const PairSystem& system, Bracket b, const Eigen::Vector3d& direction,
-              const SweepOptions& sweep, const CriticalFieldOptions& opt) {
-  const double distinct = opt.distinct_states * system.material.radius;
-  while (std::abs(b.single_field - b.bistable_field) > opt.tolerance) {
+// Validity of one search: the first relaxation that did not converge.
+struct Audit {
+  bool converged = true;
+  std::string problem;
+  void check(const PairState& s, const char* where) {
+    if (s.converged || !converged) return;
+    converged = false;
+    problem = fmt::format("relaxation did not converge at B = {:.6g} T ({})", s.field, where);
+  }
+};
+
+// Two relaxed states are different states when they lie further apart than both the fixed
+// threshold and ten times their position errors (what the solver can vouch for).
+bool differ(const PairState& a, const PairState& b, const CriticalFieldOptions& opt,
+            double radius) {
+  const double noise = 10.0 * (a.position_error + b.position_error);
+  return (a.separation - b.separation).norm() > std::max(opt.distinct_states * radius, noise);
+}
+
+struct Refined {
+  double field = 0.0;
+  double half_width = 0.0;
+};
+
+// Bisects between a bistable field and a single-state field; returns the midpoint. Stops at
+// the tolerance, or when the midpoint is no longer strictly between the ends (double
+// precision), and never after more halvings than the tolerance needs.
+Refined refine(const PairSystem& system, Bracket b, const Eigen::Vector3d& direction,
+               const SweepOptions& sweep, const CriticalFieldOptions& opt, Audit& audit) {
+  const int limit = bisection_limit(std::abs(b.single_field - b.bistable_field), opt.tolerance);
+  for (int i = 0; i < limit && std::abs(b.single_field - b.bistable_field) > opt.tolerance; ++i) {
     const double mid = 0.5 * (b.single_field + b.bistable_field);
-    const PairState a = relax_at_field(system, mid, direction, b.rising_state, sweep.relax);
-    const PairState c = relax_at_field(system, mid, direction, b.falling_state, sweep.relax);
-    if ((a.separation - c.separation).norm() > distinct) {
+    if (mid == b.single_field || mid == b.bistable_field) break;
+    const PairState a =
+        relax_at_field(system, mid, direction, b.rising_state.separation, sweep.relax);
+    const PairState c =
+        relax_at_field(system, mid, direction, b.falling_state.separation, sweep.relax);
+    audit.check(a, "bisection from the separated branch");
+    audit.check(c, "bisection from the clustered branch");
+    if (differ(a, c, opt, system.material.radius)) {
       b.bistable_field = mid;
-      b.rising_state = a.separation;
-      b.falling_state = c.separation;
+      b.rising_state = a;
+      b.falling_state = c;
     } else {
       b.single_field = mid;
     }
   }
-  return 0.5 * (b.single_field + b.bistable_field);
+  return {0.5 * (b.single_field + b.bistable_field),
+          0.5 * std::abs(b.single_field - b.bistable_field)};
 }
 
 // A bistable range narrower than the sweep step can fall between two grid fields: the rising
@@ -39,30 +81,54 @@ double refine(const PairSystem& system, Bracket b, const Eigen::Vector3d& direct
 // step: at a trial field relax from both ends' states; if they differ the field is bistable
 // (returned as a bracket for both ends), otherwise the single state tells which half the jump
 // lies in. Returns nothing if the step holds only a steep but continuous change.
-std::optional<std::pair<Bracket, Bracket>> bistable_inside_step(const PairSystem& system,
-                                                                double b_lo, Eigen::Vector3d before,
-                                                                double b_hi, Eigen::Vector3d after,
-                                                                const Eigen::Vector3d& direction,
-                                                                const SweepOptions& sweep,
-                                                                const CriticalFieldOptions& opt) {
-  const double distinct = opt.distinct_states * system.material.radius;
-  while (b_hi - b_lo > opt.tolerance) {
+std::optional<std::pair<Bracket, Bracket>> bistable_inside_step(
+    const PairSystem& system, PairState before, PairState after, const Eigen::Vector3d& direction,
+    const SweepOptions& sweep, const CriticalFieldOptions& opt, Audit& audit) {
+  double b_lo = before.field;
+  double b_hi = after.field;
+  const int limit = bisection_limit(b_hi - b_lo, opt.tolerance);
+  for (int i = 0; i < limit && b_hi - b_lo > opt.tolerance; ++i) {
     const double mid = 0.5 * (b_lo + b_hi);
-    const PairState a = relax_at_field(system, mid, direction, before, sweep.relax);
-    const PairState c = relax_at_field(system, mid, direction, after, sweep.relax);
-    if ((a.separation - c.separation).norm() > distinct) {
-      return std::pair{Bracket{mid, a.separation, c.separation, b_hi},
-                       Bracket{mid, a.separation, c.separation, b_lo}};
+    if (mid == b_lo || mid == b_hi) break;
+    const PairState a = relax_at_field(system, mid, direction, before.separation, sweep.relax);
+    const PairState c = relax_at_field(system, mid, direction, after.separation, sweep.relax);
+    audit.check(a, "search inside a sweep step");
+    audit.check(c, "search inside a sweep step");
+    if (differ(a, c, opt, system.material.radius)) {
+      return std::pair{Bracket{mid, a, c, b_hi}, Bracket{mid, a, c, b_lo}};
     }
-    if ((a.separation - before).norm() < (a.separation - after).norm()) {
+    if ((a.separation - before.separation).norm() < (a.separation - after.separation).norm()) {
       b_lo = mid;
-      before = a.separation;
+      before = a;
     } else {
       b_hi = mid;
-      after = a.separation;
+      after = a;
     }
   }
   return std::nullopt;
+}
+
+// Refines both ends from their brackets into `result`, recording validity.
+void refine_both(const PairSystem& system, const Bracket& hc2, const std::optional<Bracket>& hc1,
+                 const Eigen::Vector3d& direction, const SweepOptions& sweep,
+                 const CriticalFieldOptions& options, Audit& audit, CriticalFields& result) {
+  result.hysteresis = true;
+  const Refined up = refine(system, hc2, direction, sweep, options, audit);
+  result.hc2 = up.field;
+  result.uncertainty = up.half_width;
+  if (hc1) {
+    const Refined down = refine(system, *hc1, direction, sweep, options, audit);
+    result.hc1 = down.field;
+    result.uncertainty = std::max(result.uncertainty, down.half_width);
+  } else {  // still bistable at zero field: no H_C1 in the swept range
+    result.hc1 = 0.0;
+    result.in_range = false;
+    if (result.problem.empty()) {
+      result.problem = "the pair stays clustered at zero field (no H_C1 in [0, field.max])";
+    }
+  }
+  result.converged = audit.converged;
+  if (!audit.converged) result.problem = audit.problem;
 }
 
 }  // namespace
@@ -74,13 +140,14 @@ CriticalFields find_critical_fields(const PairSystem& system, const HysteresisLo
   // First-quadrant states of the rising (branch 0) and falling (branch 1) legs by step index.
   std::map<int, const PairState*> rising;
   std::map<int, const PairState*> falling;
+  Audit audit;
   for (const PairState& s : loop.states) {
     const int j = static_cast<int>(std::lround(s.field / step));
-    if (j < 0) continue;
+    if (j < 0 || s.branch > 1) continue;
     if (s.branch == 0) rising[j] = &s;
     if (s.branch == 1) falling[j] = &s;
+    audit.check(s, s.branch == 0 ? "rising branch of the sweep" : "falling branch of the sweep");
   }
-  const double distinct = options.distinct_states * system.material.radius;
   // Steps of the rising branch that move the pair by more than this (in R) are checked for a
   // bistable range narrower than the step.
   constexpr double kJumpFraction = 1e-2;
@@ -89,7 +156,7 @@ CriticalFields find_critical_fields(const PairSystem& system, const HysteresisLo
   for (const auto& [j, up] : rising) {
     auto down = falling.find(j);
     if (down == falling.end()) continue;
-    if ((up->separation - down->second->separation).norm() > distinct) {
+    if (differ(*up, *down->second, options, system.material.radius)) {
       if (first < 0) first = j;
       last = j;
     }
@@ -104,24 +171,22 @@ CriticalFields find_critical_fields(const PairSystem& system, const HysteresisLo
       const PairState& lo = *it->second;
       const PairState& hi = *std::next(it)->second;
       if ((hi.separation - lo.separation).norm() <= jump) continue;
-      const auto found = bistable_inside_step(system, lo.field, lo.separation, hi.field,
-                                              hi.separation, direction, sweep, options);
+      const auto found = bistable_inside_step(system, lo, hi, direction, sweep, options, audit);
       if (!found) continue;
-      result.hysteresis = true;
-      result.hc2 = refine(system, found->first, direction, sweep, options);
-      result.hc1 = refine(system, found->second, direction, sweep, options);
-      result.uncertainty = 0.5 * options.tolerance;
+      refine_both(system, found->first, found->second, direction, sweep, options, audit, result);
       return result;
     }
+    result.converged = audit.converged;
+    result.problem = audit.problem;
     return result;
   }
-  result.hysteresis = true;
   auto bracket_at = [&](int j, int neighbour) {
-    return Bracket{j * step, rising.at(j)->separation, falling.at(j)->separation, neighbour * step};
+    return Bracket{j * step, *rising.at(j), *falling.at(j), neighbour * step};
   };
-  result.hc2 = refine(system, bracket_at(last, last + 1), direction, sweep, options);
-  result.hc1 = refine(system, bracket_at(first, first - 1), direction, sweep, options);
-  result.uncertainty = 0.5 * options.tolerance;
+  // The falling branch starts one step below field.max, so last + 1 is always a swept field.
+  std::optional<Bracket> lower;
+  if (first > 0) lower = bracket_at(first, first - 1);
+  refine_both(system, bracket_at(last, last + 1), lower, direction, sweep, options, audit, result);
   return result;
 }
 

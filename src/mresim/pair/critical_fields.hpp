@@ -1,5 +1,7 @@
 #pragma once
 
+#include <string>
+
 #include "mresim/pair/hysteresis.hpp"
 
 namespace mresim::pair {
@@ -12,24 +14,43 @@ struct CriticalFields {
   bool hysteresis = false;
   double hc1 = 0.0;
   double hc2 = 0.0;
-  double uncertainty = 0.0;  // half-width of the final bracket, T
+  double uncertainty = 0.0;  // half-width of the widest final bracket, T
+  // Every relaxation used in locating them (the sweep's first quadrant and each bisection's)
+  // converged. If not, the fields may be far off (a state stuck at a wall) and must not be
+  // taken as results.
+  bool converged = true;
+  // Both lie in the swept range [0, field.max]. A pair still clustered at zero field has no
+  // H_C1 there (reported as 0): in this model it always separates at zero field (no remanence,
+  // the spring pushes it apart), so that is a failed relaxation too.
+  bool in_range = true;
+  std::string problem;  // the first reason the fields are not valid, for messages
+  bool valid() const { return converged && in_range; }
   double delta() const { return hysteresis ? hc2 - hc1 : 0.0; }
 };
 
 struct CriticalFieldOptions {
-  double tolerance = 1e-4;        // T, width of the final bracket
-  double distinct_states = 1e-3;  // two relaxed states differ if |d_a - d_b| > this * R
+  double tolerance = 1e-4;  // T, width of the final bracket
+  // Two relaxed states differ if |d_a - d_b| > this * R and by more than 10 times their
+  // estimated position errors together (so that the comparison never rests on solver noise).
+  double distinct_states = 1e-3;
 };
 
 // Finds the bistable range from a sweep's first quadrant (rising branch 0, falling branch 1)
 // and refines each end by bisection: at a trial field the pair is relaxed from both branches'
 // neighbouring states; if the two relaxed states differ, the field is inside the bistable
-// range. This locates the folds to `tolerance`, much finer than the sweep step.
+// range. This locates the folds to `tolerance`, much finer than the sweep step. Every
+// bisection stops when its midpoint can no longer be represented between its ends, so a
+// tolerance below double precision ends at the finest bracket the arithmetic allows (reported
+// in `uncertainty`).
 CriticalFields find_critical_fields(const PairSystem& system, const HysteresisLoop& loop,
                                     const CriticalFieldOptions& options = {});
 
 // Convenience for maps: first-quadrant sweep plus refinement.
 CriticalFields critical_fields_of(const PairSystem& system, const SweepOptions& sweep,
                                   const CriticalFieldOptions& options = {});
+
+// Number of halvings that narrow a bracket of width `range` to `tolerance`, limited to what a
+// double can resolve (at most 1100: from the largest double down to the smallest).
+int bisection_limit(double range, double tolerance);
 
 }  // namespace mresim::pair

@@ -40,6 +40,7 @@ PairState relax_at_field(const PairSystem& system, double b, const Eigen::Vector
   s.energy = energy.breakdown(r.separation / energy.length_scale());
   s.iterations = r.iterations;
   s.converged = r.converged;
+  s.position_error = r.position_error;
   return s;
 }
 

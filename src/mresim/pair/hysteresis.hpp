@@ -35,6 +35,7 @@ struct PairState {
   EnergyBreakdown energy;
   int iterations = 0;
   bool converged = false;
+  double position_error = 0.0;  // m, RelaxResult::position_error
 
   double distance() const { return separation.norm(); }
   double rotation_deg() const;  // angle of d from the x-axis in the xz-plane (Fig. 2.1b)

@@ -29,10 +29,17 @@ PenaltyValue tanh_penalty(const OverlapPenalty& p, double radius, double s) {
 PenaltyValue wca_penalty(const OverlapPenalty& p, double s) {
   PenaltyValue v;
   if (s > p.r_cut) return v;
+  const double q6 = std::pow(p.r_min / s, 6);
+  // The default cut-off 2^(1/6) r_min is the minimum of the Lennard-Jones form, so the penalty
+  // is purely repulsive; rounded, r_cut lands an ulp or so past that minimum, and there the
+  // sliver of attractive force (E_max is ~1e8 mu0 Ms^2 V, so ~1e-6 of the scaled force unit)
+  // would hold a soft-spring pair at the cut-off. For that cut-off the penalty is zero
+  // wherever (r_min/S)^6 <= 1/2 (exact: 2 q6 - 1 has no rounding error there).
+  const double lj_minimum = std::pow(2.0, 1.0 / 6.0) * p.r_min;
+  if (std::abs(p.r_cut - lj_minimum) <= 1e-12 * lj_minimum && 2.0 * q6 <= 1.0) return v;
   // Factored forms: E_max is ~1e8 times the magnetic energy scale, so the textbook sum
   // q^12 - q^6 + 1/4 would lose all significant digits to cancellation near the cut-off.
   // (q12 - q6) - (qc12 - qc6) = (q6 - qc6)(q6 + qc6 - 1).
-  const double q6 = std::pow(p.r_min / s, 6);
   const double qc6 = std::pow(p.r_min / p.r_cut, 6);
   v.energy = 4.0 * p.e_max * (q6 - qc6) * (q6 + qc6 - 1.0);
   v.derivative = -24.0 * p.e_max * q6 * (2.0 * q6 - 1.0) / s;

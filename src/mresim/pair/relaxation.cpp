@@ -10,12 +10,98 @@
 namespace mresim::pair {
 namespace {
 
+// Round-off of the scaled energy e.
+double roundoff(double e) {
+  return 8.0 * std::numeric_limits<double>::epsilon() * (1.0 + std::abs(e));
+}
+
+template <int N>
+struct NewtonStep {
+  using Mat = typename detail::PolarCoordinates<N>::Mat;
+  using Vec = typename detail::PolarCoordinates<N>::Vec;
+  Mat hessian;
+  Vec step;
+  double floor = 0.0;
+  bool at_resolution = false;  // the step is below what the line search can resolve
+};
+
+// Saddle-free Newton step at q: negative or vanishing curvature moves the full trust length
+// downhill. It is at resolution when every coordinate's gradient is below what the arithmetic
+// can resolve: at a stiff wall, the gradient that a displacement of step_tolerance produces;
+// along a soft direction, the gradient whose Newton step changes the energy by less than its
+// round-off. (That alone is not convergence: see detail::probe_minimum.)
+template <int N, typename Vec>
+NewtonStep<N> newton_step(const PairEnergy& energy, const Vec& q, const Vec& g,
+                          const Eigen::Vector3d& g3, double e, const RelaxOptions& opt) {
+  using C = detail::PolarCoordinates<N>;
+  NewtonStep<N> out;
+  out.hessian = C::hessian(q, g3, energy.scaled_hessian(C::separation(q)));
+  Eigen::SelfAdjointEigenSolver<typename NewtonStep<N>::Mat> eig(out.hessian);
+  // The Hessian is accurate to ~1e-10 (its magnetic part is finite-differenced), so smaller
+  // curvatures are treated as flat.
+  out.floor = 1e-10 + 1e-15 * eig.eigenvalues().cwiseAbs().maxCoeff();
+  out.step = Vec::Zero();
+  for (int i = 0; i < N; ++i) {
+    const Vec v = eig.eigenvectors().col(i);
+    const double lambda = eig.eigenvalues()(i);
+    const double gv = v.dot(g);
+    out.step -= (lambda > out.floor ? gv / lambda : std::copysign(opt.max_step, gv)) * v;
+  }
+  out.at_resolution = eig.eigenvalues().minCoeff() > out.floor &&
+                      detail::gradient_at_resolution(q, g, Vec(out.hessian.diagonal()), e,
+                                                     opt.gradient_tolerance, opt.step_tolerance);
+  return out;
+}
+
+// Armijo backtracking along the (capped) Newton step; updates q, g, g3, e and returns whether a
+// step was taken. Steps are capped at max_step and the energy never rises, so a pair cannot
+// tunnel through a penalty.
+template <int N, typename Evaluate, typename Vec>
+bool line_search(const Evaluate& evaluate, const NewtonStep<N>& newton, const RelaxOptions& opt,
+                 Vec& q, Vec& g, Eigen::Vector3d& g3, double& e) {
+  Vec step = newton.step;
+  const double length = step.norm();
+  if (length > opt.max_step) step *= opt.max_step / length;
+  double slope = g.dot(step);
+  if (slope >= 0.0) {  // not a descent direction (round-off): fall back to the gradient
+    step = -g * std::min(1.0, opt.max_step / g.norm());
+    slope = g.dot(step);
+  }
+  // Length of the Newton step a gradient asks for, so that a stiff coordinate's round-off
+  // noise does not mask progress along a soft one.
+  auto newton_length = [&](const Vec& grad) {
+    return (grad.array() / newton.hessian.diagonal().array().abs().max(newton.floor))
+        .matrix()
+        .norm();
+  };
+  double t = 1.0;
+  for (int halving = 0; halving < 47; ++halving, t *= 0.5) {  // down to t ~ 1e-14
+    const Vec q_new = q + t * step;
+    if (q_new == q) return false;  // the step is below the resolution of q
+    Vec g_new;
+    Eigen::Vector3d g3_new;
+    const double e_new = evaluate(q_new, g_new, g3_new);
+    const bool armijo = e_new <= e + 1e-4 * t * slope;
+    // Near convergence energy differences fall below round-off; a step that keeps the energy
+    // within round-off and reduces the gradient is still progress.
+    const bool roundoff = std::abs(e_new - e) <= 1e-14 * (1.0 + std::abs(e)) &&
+                          newton_length(g_new) < newton_length(g);
+    if (armijo || roundoff) {
+      q = q_new;
+      g = g_new;
+      g3 = g3_new;
+      e = e_new;
+      return true;
+    }
+  }
+  return false;
+}
+
 template <int N>
 RelaxResult newton(const PairEnergy& energy, const Eigen::Vector3d& start_scaled,
                    const RelaxOptions& opt) {
   using C = detail::PolarCoordinates<N>;
   using Vec = typename C::Vec;
-  using Mat = typename C::Mat;
   auto evaluate = [&](const Vec& q, Vec& grad, Eigen::Vector3d& g3) {
     const double e = energy.scaled_energy_and_gradient(C::separation(q), g3);
     grad = C::gradient(q, g3);
@@ -27,92 +113,58 @@ RelaxResult newton(const PairEnergy& energy, const Eigen::Vector3d& start_scaled
   Eigen::Vector3d g3;
   double e = evaluate(q, g, g3);
   RelaxResult result;
-  bool previous_at_resolution = false;
+  double bracket = 0.0;  // width of the verified bracket, units of R
   for (int it = 0; it < opt.max_iterations; ++it) {
     result.iterations = it;
     if (g.template lpNorm<Eigen::Infinity>() < opt.gradient_tolerance) {
       result.converged = true;
       break;
     }
-    const Mat hessian = C::hessian(q, g3, energy.scaled_hessian(C::separation(q)));
-    Eigen::SelfAdjointEigenSolver<Mat> eig(hessian);
-    // The Hessian is accurate to ~1e-10 (its magnetic part is finite-differenced), so smaller
-    // curvatures are treated as flat.
-    const double floor = 1e-10 + 1e-15 * eig.eigenvalues().cwiseAbs().maxCoeff();
-    Vec step = Vec::Zero();
-    for (int i = 0; i < N; ++i) {
-      const Vec v = eig.eigenvectors().col(i);
-      const double lambda = eig.eigenvalues()(i);
-      const double gv = v.dot(g);
-      // Negative (or vanishing) curvature: move the full trust length downhill along v.
-      step -= (lambda > floor ? gv / lambda : std::copysign(opt.max_step, gv)) * v;
-    }
-    const double length = step.norm();
-    // A coordinate is converged when its gradient is below what the arithmetic can resolve:
-    // at a stiff wall, the gradient that a displacement of step_tolerance produces; along a
-    // soft direction, the gradient whose Newton step changes the energy by less than its
-    // round-off. (A small Newton step alone is not enough: at the WCA cut-off the curvature
-    // jumps, and the step from inside is tiny although the minimum lies outside.)
-    const double energy_resolution =
-        8.0 * std::numeric_limits<double>::epsilon() * (1.0 + std::abs(e));
-    bool at_resolution = eig.eigenvalues().minCoeff() > floor;
-    for (int i = 0; i < N && at_resolution; ++i) {
-      const double curvature = std::abs(hessian(i, i));
-      at_resolution = std::abs(g(i)) <= opt.gradient_tolerance +
-                                            opt.step_tolerance * (1.0 + q.norm()) * curvature +
-                                            std::sqrt(2.0 * curvature * energy_resolution);
-    }
-    // Require it at two successive iterates: at a kink (the WCA cut-off) the point just across
-    // has a different curvature and fails the test there.
-    if (at_resolution && previous_at_resolution) {
-      result.converged = true;
-      break;
-    }
-    previous_at_resolution = at_resolution;
-    if (length > opt.max_step) step *= opt.max_step / length;
-    double slope = g.dot(step);
-    if (slope >= 0.0) {  // not a descent direction (round-off): fall back to the gradient
-      step = -g * std::min(1.0, opt.max_step / g.norm());
-      slope = g.dot(step);
-    }
-
-    // Length of the Newton step a gradient asks for, so that a stiff coordinate's round-off
-    // noise does not mask progress along a soft one.
-    auto newton_length = [&](const Vec& grad) {
-      return (grad.array() / hessian.diagonal().array().abs().max(floor)).matrix().norm();
-    };
-    bool accepted = false;
-    double t = 1.0;
-    for (int halving = 0; halving < 47; ++halving, t *= 0.5) {  // down to t ~ 1e-14
-      const Vec q_new = q + t * step;
-      Vec g_new;
-      Eigen::Vector3d g3_new;
-      const double e_new = evaluate(q_new, g_new, g3_new);
-      const bool armijo = e_new <= e + 1e-4 * t * slope;
-      // Near convergence energy differences fall below round-off; a step that keeps the energy
-      // within round-off and reduces the gradient is still progress.
-      const bool roundoff = std::abs(e_new - e) <= 1e-14 * (1.0 + std::abs(e)) &&
-                            newton_length(g_new) < newton_length(g);
-      if (armijo || roundoff) {
-        if (q_new == q) {  // the step is below the resolution of q: nothing left to gain
-          result.converged = at_resolution;
-          break;
+    const Vec q_before = q;
+    const NewtonStep<N> newton = newton_step<N>(energy, q, g, g3, e, opt);
+    result.iterations = it + 1;
+    if (newton.at_resolution) {
+      const detail::Probe<N> probe =
+          detail::probe_minimum<N>(q, g, newton.step, opt.gradient_tolerance, evaluate);
+      if (probe.brackets) {  // finish on the Newton point, the best estimate inside the bracket
+        Vec g_end;
+        Eigen::Vector3d g3_end;
+        const Vec q_end = q + newton.step;
+        if (q_end != q && evaluate(q_end, g_end, g3_end) <= e + detail::energy_roundoff(e)) {
+          q = q_end;
+          g = g_end;
+          g3 = g3_end;
         }
-        q = q_new;
-        g = g_new;
-        g3 = g3_new;
-        e = e_new;
-        accepted = true;
+        bracket = (C::separation(probe.q) - C::separation(q_before)).norm();
+        result.converged = true;
         break;
       }
+      // The minimum lies beyond the probe (a curvature jump or a wall's tail). The gradient
+      // kept its sign, so the energy fell, if below its round-off: move on from there.
+      if (probe.energy <= e + detail::energy_roundoff(e)) {
+        q = probe.q;
+        g = probe.gradient;
+        g3 = probe.gradient3;
+        e = probe.energy;
+        continue;
+      }
     }
-    result.iterations = it + 1;
-    if (!accepted || result.converged) break;
+    if (!line_search<N>(evaluate, newton, opt, q, g, g3, e)) {
+      // No step is accepted: the minimum may lie within a few ulps of q where the curvature
+      // at q (negative just past the WCA's edge) does not describe it; verify that.
+      result.converged =
+          detail::minimum_next_to<N>(q, g, opt.gradient_tolerance, evaluate, bracket);
+      break;
+    }
   }
   if (!result.converged) {
     result.converged = g.template lpNorm<Eigen::Infinity>() < opt.gradient_tolerance;
   }
   result.separation = C::separation(q) * energy.length_scale();
+  // A verified bracket bounds the error; otherwise the Newton step estimates it (it
+  // overstates it where the curvature at q is not the minimum's, hence not both).
+  result.position_error = (bracket > 0.0 ? bracket : detail::newton_distance<N>(energy, q, g, g3)) *
+                          energy.length_scale();
   return result;
 }
 

@@ -23,6 +23,9 @@ struct RelaxResult {
   Eigen::Vector3d separation;  // d = r1 - r2 in metres
   int iterations = 0;
   bool converged = false;
+  // Estimate of the distance to the minimum in metres: the last step taken (Newton converges
+  // quadratically, so it bounds what is left), or the width of the verified bracket.
+  double position_error = 0.0;
 };
 
 // Local energy minimisation from a starting configuration, so that a field sweep follows its

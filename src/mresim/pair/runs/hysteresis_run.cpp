@@ -57,10 +57,11 @@ class HysteresisPlan final : public app::RunPlan {
     errors.rethrow();
 
     app::ResultCheck check("non-finite results");
+    app::ResultCheck unmarked("critical fields not valid");
     io::CsvWriter summary(staging_dir / "summary.csv", loop_csv_columns());
     io::CsvWriter critical(
         staging_dir / "critical_fields.csv",
-        {"case", "label", "hysteresis", "HC1_T", "HC2_T", "dH_T", "uncertainty_T"});
+        {"case", "label", "hysteresis", "HC1_T", "HC2_T", "dH_T", "uncertainty_T", "valid"});
     for (std::size_t c = 0; c < cases_.size(); ++c) {
       const std::string group = fmt::format("/cases/{}", c);
       append_loop_rows(summary, c, cases_[c], loops[c]);
@@ -68,8 +69,11 @@ class HysteresisPlan final : public app::RunPlan {
       write_critical_fields_hdf5(results, group + "/critical_fields", fields[c]);
       check_loop(check, c, cases_[c], loops[c]);
       check_critical_fields(check, fmt::format("case {} ({})", c, cases_[c].label), fields[c]);
+      check_critical_fields_valid(unmarked, fmt::format("case {} ({})", c, cases_[c].label),
+                                  fields[c]);
       critical.row_cells({static_cast<double>(c), cases_[c].label, fields[c].hysteresis ? 1.0 : 0.0,
-                          fields[c].hc1, fields[c].hc2, fields[c].delta(), fields[c].uncertainty});
+                          fields[c].hc1, fields[c].hc2, fields[c].delta(), fields[c].uncertainty,
+                          fields[c].valid() ? 1.0 : 0.0});
       if (const std::size_t bad = unconverged_states(loops[c]); bad > 0) {
         std::cerr << fmt::format(
             "mresim: warning: case {} ({}): {} of {} states did not reach "
@@ -81,6 +85,8 @@ class HysteresisPlan final : public app::RunPlan {
     write_warnings_attribute(results, warnings_);
     check.throw_if_any(
         "written as NaN; see /cases/<i>/valid in results.h5 and the valid column of summary.csv");
+    unmarked.throw_if_any(
+        "written with valid = 0 in critical_fields.csv and /cases/<i>/critical_fields/@valid");
   }
 
  private:

@@ -104,13 +104,16 @@ class MapPlan final : public app::RunPlan {
     std::vector<std::int64_t> hysteresis;
     std::vector<double> valid;
     app::ResultCheck check("non-finite results");
+    app::ResultCheck unmarked("critical fields not valid");
     for (std::size_t r = 0; r < rows; ++r) {
       for (std::size_t c = 0; c < cols; ++c) {
         const CriticalFields& f = grid.at(r, c);
         const PairSystem p = point(r, c).system;
-        const bool ok = std::isfinite(f.hc1) && std::isfinite(f.hc2);
-        check_critical_fields(
-            check, fmt::format("row {}, col {} (S0 = {:.6g} m)", r, c, separations_[c]), f);
+        const bool ok = std::isfinite(f.hc1) && std::isfinite(f.hc2) && f.valid();
+        const std::string where =
+            fmt::format("row {}, col {} (S0 = {:.6g} m)", r, c, separations_[c]);
+        check_critical_fields(check, where, f);
+        check_critical_fields_valid(unmarked, where, f);
         csv.row({static_cast<double>(r), static_cast<double>(c), rows_[r], separations_[c],
                  f.hysteresis ? 1.0 : 0.0, f.hc1, f.hc2, f.delta(), p.springs.k12, p.springs.k0,
                  ok ? 1.0 : 0.0});
@@ -145,6 +148,7 @@ class MapPlan final : public app::RunPlan {
     check.throw_if_any(
         "written as NaN; see /map/valid in results.h5 and the valid column of "
         "summary.csv");
+    unmarked.throw_if_any("see /map/valid in results.h5 and the valid column of summary.csv");
   }
 
   // The spring constants of the rows in the solver's units (k R^2 / mu0 Ms^2 V) and the spring

@@ -164,6 +164,14 @@ void write_critical_fields_hdf5(io::Hdf5File& h5, const std::string& group,
   h5.write_number_attribute(group, "HC2_T", f.hc2);
   h5.write_number_attribute(group, "dH_T", f.delta());
   h5.write_number_attribute(group, "uncertainty_T", f.uncertainty);
+  h5.write_int_attribute(group, "valid", f.valid() ? 1 : 0);
+  h5.write_int_attribute(group, "converged", f.converged ? 1 : 0);
+  h5.write_string_attribute(group, "problem", f.problem);
+}
+
+void check_critical_fields_valid(app::ResultCheck& check, const std::string& where,
+                                 const CriticalFields& f) {
+  if (!f.valid()) check.flag("H_C1/H_C2", where + ": " + f.problem);
 }
 
 void describe_pair(app::InfoReport& report, const std::string& section, const PairSetup& setup) {

@@ -40,6 +40,10 @@ void check_loop(app::ResultCheck& check, std::size_t case_index, const PairSetup
                 const HysteresisLoop& loop);
 void check_critical_fields(app::ResultCheck& check, const std::string& where,
                            const CriticalFields& fields);
+// Flags critical fields that are not valid (CriticalFields::valid(): a relaxation used in
+// locating them did not converge, or H_C1 is not in the swept range), naming the problem.
+void check_critical_fields_valid(app::ResultCheck& check, const std::string& where,
+                                 const CriticalFields& fields);
 
 // Prints each read-time warning as "mresim: warning: ..." on stderr and returns them.
 void print_warnings(const std::vector<std::string>& warnings);

@@ -332,6 +332,15 @@ PairSetup read_pair_setup(const TableReader& scope, const PairSetup& base, bool 
       t->fail("tolerance", s.critical_field_tolerance,
               fmt::format("must be < field.step = {} T", s.sweep.b_step));
     }
+    // Bisection cannot narrow a bracket below the spacing of doubles near the field; 1e-12 of
+    // the swept range keeps well clear of it (about 1e4 ulps at field.max).
+    const double finest = 1e-12 * s.sweep.b_max;
+    if (s.critical_field_tolerance < finest) {
+      t->fail("tolerance", s.critical_field_tolerance,
+              fmt::format("must be in [{:g}, {:g}) T: at least 1e-12 x field.max (finer is below "
+                          "what double precision resolves) and below field.step",
+                          finest, s.sweep.b_step));
+    }
   }
   validate_pair(scope, s);
   return s;
