@@ -89,6 +89,20 @@ TEST(TwoDipoleSoftSprings, PairSeparatesAtZeroFieldAndReleasesAtThePositiveForce
   EXPECT_NEAR(cf.hc1, analytic_release_field(p, p.penalty.r_cut), 1e-6);
 }
 
+// Defect: the gradient tolerance was absolute, so for k = 1e-10 N/m the zero-field state was
+// 9 nm short of S0 and for k <= 1e-12 N/m a pair in contact at zero field counted as relaxed.
+TEST(TwoDipoleSoftSprings, ZeroFieldStateIsAtTheRestSeparationWhateverTheStiffness) {
+  for (const double k : {1e-10, 1e-12, 1e-14}) {
+    for (const PenaltyKind penalty : {PenaltyKind::tanh, PenaltyKind::wca}) {
+      const PairSystem p = single_spring(k, penalty);
+      const PairState s =
+          relax_at_field(p, 0.0, field_direction(0.0), Eigen::Vector3d(3.2e-6, 0.0, 0.0), {});
+      EXPECT_TRUE(s.converged) << k;
+      EXPECT_NEAR(s.distance(), 9e-6, 1e-14) << k;
+    }
+  }
+}
+
 // Property: over a grid of stiffnesses (down to the tanh's former failure at 3e-8 N/m) and both
 // penalties, Newton's critical fields are valid, lie in [0, field.max] and are ordered.
 TEST(TwoDipoleSoftSprings, CriticalFieldsLieInTheSweptRange) {

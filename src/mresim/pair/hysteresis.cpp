@@ -1,5 +1,6 @@
 #include "mresim/pair/hysteresis.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -29,10 +30,32 @@ Eigen::Vector3d rest_configuration(const PairSystem& system) {
   return {system.springs.rest_separation, 0.0, 0.0};
 }
 
+namespace {
+
+RelaxOptions with_stiffness_scaled_tolerance(const PairSystem& system, RelaxOptions options) {
+  // The gradient tolerance is absolute (units of mu0 Ms^2 V / R); a pair held only by its
+  // springs is then placed to tolerance / k in units of R. For soft springs that grows past
+  // what the branch comparison resolves (k = 1e-10 N/m: 9 nm at zero field; k <= 1e-12 N/m: a
+  // pair in contact at zero field counts as relaxed), so the tolerance is held at a gradient
+  // of k x 1e-9 R whatever the stiffness (unchanged from k ~ 1.5e-2 N/m up).
+  const SphereMaterial& m = system.material;
+  const double k_axial =
+      system.springs.k12 +
+      (system.springs.model == SpringModel::three ? 0.5 * system.springs.k0 : 0.0);
+  const double k_scaled = k_axial * m.radius * m.radius / m.magnetic_energy_scale();
+  if (k_scaled > 0.0) {
+    options.gradient_tolerance = std::min(options.gradient_tolerance, 1e-9 * k_scaled);
+  }
+  return options;
+}
+
+}  // namespace
+
 PairState relax_at_field(const PairSystem& system, double b, const Eigen::Vector3d& direction,
                          const Eigen::Vector3d& start, const RelaxOptions& options) {
   const PairEnergy energy(system, b * direction);
-  const RelaxResult r = relax(energy, system.springs.model, start, options);
+  const RelaxResult r =
+      relax(energy, system.springs.model, start, with_stiffness_scaled_tolerance(system, options));
   PairState s;
   s.field = b;
   s.separation = r.separation;
