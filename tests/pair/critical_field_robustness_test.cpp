@@ -146,6 +146,31 @@ TEST(TwoDipoleThreeSprings, ConjugateGradientsGiveNewtonsCriticalFields) {
   EXPECT_NEAR(b.hc1, a.hc1, options.tolerance);
 }
 
+// Over part of the Fig. 2.9 grid the conjugate gradients converge (no marked fields) and find
+// Newton's critical fields. (Before the conjugate gradients probed past the WCA's edge, three
+// of these points stopped unconverged with H_C1 up to 0.5 mT off.)
+TEST(TwoDipoleThreeSprings, ConjugateGradientsAgreeWithNewtonOverAngleAndSeparation) {
+  for (const double angle : {0.0, 45.0, 70.0}) {
+    for (const double s0 : {4.4e-6, 6e-6, 10e-6}) {
+      PairSystem p;
+      const PuljizStiffness k = puljiz_stiffness(1375.0, kR, s0);
+      p.springs = {SpringModel::three, k.k12, k.k0, s0};
+      p.penalty = OverlapPenalty::wca_default(kR);
+      SweepOptions newton = sweep_with(RelaxMethod::newton);
+      SweepOptions cg = sweep_with(RelaxMethod::conjugate_gradient);
+      newton.theta_h_deg = cg.theta_h_deg = angle;
+      const CriticalFields a = critical_fields_of(p, newton);
+      const CriticalFields b = critical_fields_of(p, cg);
+      const std::string where = std::to_string(angle) + " deg, S0 = " + std::to_string(s0);
+      EXPECT_TRUE(a.valid()) << where << ": " << a.problem;
+      EXPECT_TRUE(b.valid()) << where << ": " << b.problem;
+      EXPECT_EQ(a.hysteresis, b.hysteresis) << where;
+      EXPECT_NEAR(a.hc1, b.hc1, 1e-4) << where;
+      EXPECT_NEAR(a.hc2, b.hc2, 1e-4) << where;
+    }
+  }
+}
+
 // Defect: a tolerance below double precision never ended the bisection. Called directly (no
 // run-file validation), it must end at the finest bracket the arithmetic allows and say so.
 TEST(CriticalFieldBisection, EndsWhenTheToleranceIsBelowDoublePrecision) {

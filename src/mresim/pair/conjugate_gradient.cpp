@@ -1,3 +1,4 @@
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 
@@ -71,6 +72,7 @@ RelaxResult relax_conjugate_gradient(const PairEnergy& energy, const Eigen::Vect
                                      const RelaxOptions& opt) {
   using C = detail::PolarCoordinates<N>;
   using Vec = typename C::Vec;
+  using Mat = typename C::Mat;
   auto evaluate = [&](const Vec& q, Vec& grad, Eigen::Vector3d& g3) {
     const double e = energy.scaled_energy_and_gradient(C::separation(q), g3);
     grad = C::gradient(q, g3);
@@ -85,30 +87,48 @@ RelaxResult relax_conjugate_gradient(const PairEnergy& energy, const Eigen::Vect
   Vec g_old = Vec::Zero();
   RelaxResult result;
   double bracket = 0.0;  // width of the verified bracket, units of R
+  bool restart = true;   // start (again) along the preconditioned gradient
   for (int it = 0; it < opt.max_iterations; ++it) {
     result.iterations = it;
     if (g.template lpNorm<Eigen::Infinity>() < opt.gradient_tolerance) {
       result.converged = true;
       break;
     }
-    const Vec curvature = C::hessian(q, g3, energy.scaled_hessian(C::separation(q))).diagonal();
+    const Mat hessian = C::hessian(q, g3, energy.scaled_hessian(C::separation(q)));
+    const Vec curvature = hessian.diagonal();
     const Vec inverse = Vec::Ones().cwiseQuotient(curvature.cwiseAbs().cwiseMax(1e-10));
     const Vec preconditioned = inverse.cwiseProduct(g);
     if (detail::gradient_at_resolution(q, g, curvature, e, opt.gradient_tolerance,
                                        opt.step_tolerance)) {
+      // Verification only (the iteration stays conjugate gradients): the full Newton step
+      // where the Hessian is positive definite, so coupled coordinates are probed together.
+      const Eigen::LDLT<Mat> ldlt(hessian);
+      const bool definite =
+          ldlt.info() == Eigen::Success && ldlt.isPositive() && ldlt.vectorD().minCoeff() > 1e-10;
+      const Vec step = definite ? Vec(-ldlt.solve(g)) : Vec(-preconditioned);
       const detail::Probe<N> probe =
-          detail::probe_minimum<N>(q, g, Vec(-preconditioned), opt.gradient_tolerance, evaluate);
+          detail::probe_minimum<N>(q, g, step, opt.gradient_tolerance, evaluate);
       if (probe.brackets) {
         bracket = (C::separation(probe.q) - C::separation(q)).norm();
         result.converged = true;
         break;
       }
+      if (probe.energy <= e + detail::energy_roundoff(e)) {  // past a curvature jump: go on
+        q = probe.q;  // from the probe, along its own gradient (as in Newton's iteration)
+        g = probe.gradient;
+        g3 = probe.gradient3;
+        e = probe.energy;
+        restart = true;
+        result.iterations = it + 1;
+        continue;
+      }
     }
     // PR+ with the preconditioner; restart along the preconditioned gradient when conjugacy
     // is lost (or on the first iteration).
     const double beta =
-        it == 0 ? 0.0
+        restart ? 0.0
                 : std::max(0.0, preconditioned.dot(g - g_old) / preconditioned_old.dot(g_old));
+    restart = false;
     direction = -preconditioned + beta * direction;
     double slope0 = g.dot(direction);
     if (!(slope0 < 0.0)) {
