@@ -5,15 +5,18 @@
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
-#include <signal.h>
 #include <sys/wait.h>
 #include <toml++/toml.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
+#include <csignal>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
+#include <iterator>
 #include <map>
 #include <set>
 #include <sstream>
@@ -64,7 +67,7 @@ Case load_case(const fs::path& dir) {
   static const std::set<std::string> kKeys = {"args",   "status",  "message",
                                               "absent", "pending", "note"};
   for (const auto& [key, value] : t) {
-    if (!kKeys.count(std::string(key.str())))
+    if (!kKeys.contains(std::string(key.str())))
       c.problem += "unknown key '" + std::string(key.str()) + "'; ";
   }
   if (const auto* args = t["args"].as_array()) {
@@ -77,8 +80,8 @@ Case load_case(const fs::path& dir) {
   if (t.contains("status") && !t["status"].is_integer())
     c.problem += "status: expected an integer; ";
   c.status = static_cast<int>(t["status"].value_or(std::int64_t{2}));
-  if (!t["message"].is_string()) c.problem += "message: required string; ";
   c.message = t["message"].value_or(std::string());
+  if (c.message.empty()) c.problem += "message: required, a non-empty string; ";
   if (t.contains("absent") && !t["absent"].is_string()) c.problem += "absent: expected a string; ";
   c.absent = t["absent"].value_or(std::string());
   if (t.contains("pending") && !t["pending"].is_string())
@@ -133,6 +136,7 @@ Outcome run_mresim(const fs::path& work, const std::vector<std::string>& args) {
   std::vector<std::string> words = {MRESIM_CLI_PATH};
   words.insert(words.end(), args.begin(), args.end());
   std::vector<char*> argv;
+  argv.reserve(words.size() + 1);
   for (auto& w : words) argv.push_back(w.data());
   argv.push_back(nullptr);
 
@@ -200,7 +204,7 @@ std::string differences(const std::map<std::string, std::string>& before,
       names += " changed " + name + ";";
   }
   for (const auto& [name, content] : before) {
-    if (!after.count(name)) names += " removed " + name + ";";
+    if (!after.contains(name)) names += " removed " + name + ";";
   }
   return names;
 }
