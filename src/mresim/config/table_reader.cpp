@@ -201,12 +201,12 @@ void TableReader::fail(std::string_view key, double value, std::string_view what
   fail(key, fmt::format("{}", value), what_is_allowed);
 }
 
-void TableReader::fail_missing(std::string_view key, std::string_view kind,
-                               std::string_view detail) const {
-  std::string message = kind == "table" ? fmt::format("missing table [{}]", path(key))
-                                        : fmt::format("missing key '{}'", path(key));
-  message += detail;
-  // A missing key is very often a misspelt one: point at the closest key nobody asked for.
+std::string TableReader::misspelling_hint(std::string_view key) const {
+  return misspelling_hint_for(key, false);
+}
+
+// A missing key is very often a misspelt one: point at the closest key nobody asked for.
+std::string TableReader::misspelling_hint_for(std::string_view key, bool table) const {
   const auto known = doc_->known.find(path_);
   std::string best;
   std::size_t best_distance = typo_tolerance(key.size()) + 1;
@@ -219,10 +219,17 @@ void TableReader::fail_missing(std::string_view key, std::string_view kind,
       best = std::string(name);
     }
   }
-  if (!best.empty()) {
-    message += kind == "table" ? fmt::format("; the file has [{}] - a misspelling?", path(best))
-                               : fmt::format("; the file has '{}' - a misspelling?", path(best));
-  }
+  if (best.empty()) return {};
+  return table ? fmt::format("; the file has [{}] - a misspelling?", path(best))
+               : fmt::format("; the file has '{}' - a misspelling?", path(best));
+}
+
+void TableReader::fail_missing(std::string_view key, std::string_view kind,
+                               std::string_view detail) const {
+  std::string message = kind == "table" ? fmt::format("missing table [{}]", path(key))
+                                        : fmt::format("missing key '{}'", path(key));
+  message += detail;
+  message += kind == "table" ? misspelling_hint_for(key, true) : misspelling_hint(key);
   throw ConfigError(message);
 }
 

@@ -89,6 +89,10 @@ class TableReader {
   [[noreturn]] void fail(std::string_view key, double value,
                          std::string_view what_is_allowed) const;
 
+  // For callers' own "missing key" messages: "; the file has 'field.stpes' - a misspelling?"
+  // when this table has a key nobody asked for within a few edits of `key`, else "".
+  [[nodiscard]] std::string misspelling_hint(std::string_view key) const;
+
   // Throws for the first key (in document order) below this table that no getter asked for:
   // "unknown key 'field.stpe' in [field]; allowed keys: angle, max, step" or
   // "unknown table [fiedl]; allowed: field, model, run".
@@ -105,6 +109,7 @@ class TableReader {
   [[nodiscard]] const void* lookup(std::string_view key) const;
   [[noreturn]] void fail_missing(std::string_view key, std::string_view kind,
                                  std::string_view detail) const;
+  [[nodiscard]] std::string misspelling_hint_for(std::string_view key, bool table) const;
   [[nodiscard]] double to_number(const void* node, const std::string& path, Range range,
                                  std::string_view unit) const;
 

@@ -314,6 +314,21 @@ void describe_solver(const MessSpec& s, app::InfoReport& r) {
   r.add_text(sec, "magnetization_check_stability", m.check_stability ? "on" : "off");
 }
 
+// The estimate a run is checked against (check_memory), and the memory available now.
+void describe_memory(const MessSpec& s, app::InfoReport& r) {
+  constexpr double kMiB = 1 << 20;
+  r.add("memory", "estimate", static_cast<double>(estimated_memory_bytes(s)) / kMiB, "MiB",
+        fmt::format("{:.0f} MiB + {} bytes per node + 32 (3N)^2 bytes for N particles",
+                    static_cast<double>(kFixedBytes) / kMiB, kBytesPerNode));
+  const AvailableMemory available = available_memory();
+  if (available.bytes) {
+    r.add("memory", "available", static_cast<double>(*available.bytes) / kMiB, "MiB",
+          available.source + "; a run needing more is refused");
+  } else {
+    r.add_text("memory", "available", "unknown", "no check");
+  }
+}
+
 }  // namespace
 
 void describe_mess(const MessSpec& s, app::InfoReport& r) {
@@ -323,6 +338,7 @@ void describe_mess(const MessSpec& s, app::InfoReport& r) {
                                                       s.field.values.size(), s.load_step_count())
                                         : "one per field");
   describe_lattice(s, r);
+  describe_memory(s, r);
   describe_stiffness(s, r);
   describe_scales(s, r);
   describe_particles(s, r);
@@ -336,6 +352,9 @@ void describe_mess(const MessSpec& s, app::InfoReport& r) {
                  : "");
   r.add_integer("output", "checkpoint_every", s.output.checkpoint_every, "steps",
                 s.output.checkpoint_every == 0 ? "no checkpoints" : "");
+  for (std::size_t i = 0; i < s.warnings.size(); ++i) {
+    r.add_text("warnings", fmt::format("warning_{}", i), s.warnings[i]);
+  }
 }
 
 }  // namespace mresim::mess_config

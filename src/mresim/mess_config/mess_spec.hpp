@@ -194,6 +194,15 @@ MessGeometry derive_geometry(const lattice::LatticeSpec& spec);
 // ---------------------------------------------------------------------------------------------
 // The whole run file
 
+// Regular placements: the actual volume fraction of the lattice may differ from
+// particles.volume_fraction by this much (relative) before the reader warns.
+inline constexpr double kVolumeFractionTolerance = 0.01;
+
+// particles.radius must lie in [kMinRadius, kMaxRadius] m: l_e, R^3 and R^6 (products of two
+// dipole moments) stay normal doubles with room for the other factors.
+inline constexpr double kMinRadius = 1e-30;
+inline constexpr double kMaxRadius = 1e30;
+
 struct MessSpec {
   MessRunType run_type = MessRunType::hysteresis;
   std::string title;  // [run].title
@@ -217,6 +226,11 @@ struct MessSpec {
 
   MessGeometry geometry;
 
+  // Read-time warnings (input that the model changes, e.g. the actual volume fraction of a
+  // regular placement), one line each without "mresim: warning: "; the run type prints them and
+  // records them in results.h5 /@warnings.
+  std::vector<std::string> warnings;
+
   // Load values (strain or stress; 1 for the other run types).
   std::size_t load_step_count() const;
   // Relaxations the run performs: fields x load values.
@@ -233,6 +247,35 @@ MessSpec read_mess_spec(const config::TableReader& root, std::string_view run_ty
 // What app::make_plan will do once the run types are registered: reads [run] (type one of the
 // four names, title, threads), then read_mess_spec, then rejects unknown keys anywhere.
 MessSpec read_mess_run_file(const config::TableReader& root);
+
+// ---------------------------------------------------------------------------------------------
+// Memory (docs/run-files-3d.md, "Memory"): a run is refused before anything is allocated or
+// written when its estimated peak exceeds the memory available to the process.
+
+// Measured peak resident memory of a 3D run with the minimiser, per lattice node (nodes,
+// springs, cells, forces, the minimiser's history and the checkpoint copy together; the slope of
+// peak RSS between an 18,081- and a 58,621-node run is 1,513 bytes), rounded up.
+inline constexpr std::int64_t kBytesPerNode = 1600;
+// The process itself (libraries, HDF5, buffers): peak RSS of the 1,800-node run is 20 MB.
+inline constexpr std::int64_t kFixedBytes = 32LL << 20;
+
+// kFixedBytes + kBytesPerNode x nodes + the magnetization solve's dense 3N x 3N matrices
+// (Hessian, its factorization, the eigen-decomposition and Anderson's history: 4 x 8 (3N)^2
+// bytes for N particles).
+std::int64_t estimated_memory_bytes(const MessSpec& spec);
+
+struct AvailableMemory {
+  std::optional<std::int64_t> bytes;  // std::nullopt: unknown (no check)
+  std::string source;                 // "MRESIM_MEMORY_LIMIT", "MemAvailable", "cgroup memory.max"
+};
+// MRESIM_MEMORY_LIMIT (bytes, a positive integer) when set; otherwise the smaller of MemAvailable
+// in /proc/meminfo and the cgroup limit /sys/fs/cgroup/memory.max. Throws config::ConfigError for
+// an MRESIM_MEMORY_LIMIT that is not a positive integer.
+AvailableMemory available_memory();
+
+// Throws config::ConfigError (one line: nodes, the estimate, the memory available and where that
+// figure comes from) when estimated_memory_bytes(spec) exceeds `available`.
+void check_memory(const MessSpec& spec, const AvailableMemory& available);
 
 // Adds to `report` everything the spec implies without running: lattice counts (nodes, cells,
 // springs by kind), l_e, spring constants and kappa of the profile and the lattice moduli they

@@ -49,8 +49,16 @@ std::string text_or(const TableReader& t, std::string_view key, const std::strin
   return text.empty() ? fallback : text;
 }
 
+// A required key that is absent; names a likely misspelling of it the file has (the same hint
+// as TableReader's own "missing key" messages).
 [[noreturn]] void missing(const TableReader& t, std::string_view key, std::string_view what) {
-  throw ConfigError(fmt::format("missing key '{}' ({})", t.path(key), what));
+  throw ConfigError(
+      fmt::format("missing key '{}' ({}){}", t.path(key), what, t.misspelling_hint(key)));
+}
+
+// The same, for a key that another key needs: "field.steps = (missing): field.max needs ...".
+[[noreturn]] void needed(const TableReader& t, std::string_view key, const std::string& what) {
+  t.fail(key, "(missing)", what + t.misspelling_hint(key));
 }
 
 // ------------------------------------------------------------------------------------ [model]
@@ -340,10 +348,58 @@ void derive_checked(const TableReader& root, const TableReader& t, MessSpec& s) 
   }
 }
 
+// A regular placement whose lattice has a volume fraction more than kVolumeFractionTolerance
+// (relative) away from the requested one: why (the anisotropy factors' product scales the box,
+// eq. 4.52 with side n_a s f_a; the box is rounded to whole lattice spacings), or "".
+std::string volume_fraction_warning(const TableReader& t, const MessSpec& s) {
+  const auto* r = std::get_if<lattice::RegularPlacement>(&s.lattice.placement);
+  if (r == nullptr) return {};
+  const double requested = r->volume_fraction;
+  const double actual = s.geometry.volume_fraction;
+  if (!(std::abs(actual / requested - 1.0) > kVolumeFractionTolerance)) return {};
+  const double product =
+      r->anisotropic ? r->anisotropy_factor[0] * r->anisotropy_factor[1] * r->anisotropy_factor[2]
+                     : 1.0;
+  // Phi_actual = Phi / (product x rounding): what is left after the factors is the rounding.
+  const double rounding = requested / (actual * product);
+  std::string keys = t.path("volume_fraction") + " = " + t.value_text("volume_fraction");
+  std::string why;
+  if (std::abs(product - 1.0) > 1e-12) {
+    keys += " with " + t.path("anisotropy_factor") + " = " + t.value_text("anisotropy_factor");
+    why = fmt::format(
+        "the box side along each axis is n_a s f_a, so the factors' product fx fy fz = {:.6g} "
+        "divides the volume fraction (a single number f, sides 1/sqrt(f), 1/sqrt(f), f, keeps "
+        "it); ",
+        product);
+  }
+  why += fmt::format(
+      "rounding the box to whole lattice spacings (l_e = {:.6g} m, {} x {} x {} nodes) changes "
+      "the box volume by a factor {:.6g}",
+      s.geometry.element_length, s.geometry.shape.nx(), s.geometry.shape.ny(),
+      s.geometry.shape.nz(), rounding);
+  return fmt::format(
+      "{}: the lattice's actual volume fraction is {:.6g}, not {:.6g} ({:+.3g} %): {}", keys,
+      actual, requested, 100.0 * (actual / requested - 1.0), why);
+}
+
+// R itself, before anything derived from it (l_e, the box, the volumes) can fail on another key.
+double read_radius(const TableReader& t) {
+  const double r = t.number_or("radius", 1.5e-6, Range::positive(), "m");
+  if (!(r >= kMinRadius && r <= kMaxRadius)) {
+    t.fail("radius", t.value_text("radius"),
+           fmt::format("must be in [{:g}, {:g}] m: the lattice spacing l_e = 2R/(2 n_d + 1), the "
+                       "particle volume 4/3 pi R^3 and the products of two dipole moments "
+                       "(~ Ms^2 R^6) must stay normal doubles (the particles of an MRE are "
+                       "of order 1e-6 m)",
+                       kMinRadius, kMaxRadius));
+  }
+  return r;
+}
+
 void read_particles(const TableReader& root, MessSpec& s) {
   const TableReader t = root.table("particles");
   magnetism::MagneticParticles& p = s.particles;
-  p.radius = t.number_or("radius", 1.5e-6, Range::positive(), "m");
+  p.radius = read_radius(t);
   p.Ms = t.number_or("saturation_magnetization", 1.6e6, Range::positive(), "A/m");
   p.chi0 = t.number_or("susceptibility", 70.0, Range::positive(), "");
   s.demagnetization = t.boolean_or("demagnetization", false);
@@ -356,6 +412,8 @@ void read_particles(const TableReader& root, MessSpec& s) {
   s.lattice.particle_radius = p.radius;
   read_placement(root, t, s);
   derive_checked(root, t, s);
+  const std::string w = volume_fraction_warning(t, s);
+  if (!w.empty()) s.warnings.push_back(w);
 }
 
 // ------------------------------------------------------------------------------------ [field]
@@ -381,7 +439,7 @@ void read_field(const TableReader& root, MessRunType type, FieldSpec& f) {
   if (has_magnitudes) forms.emplace_back("magnitudes");
   if (has_values) forms.emplace_back("values");
   if (forms.empty()) {
-    t.fail("max", "(missing)",
+    needed(t, "max",
            "give field.max and field.steps, field.magnitudes = [...] or field.values = "
            "[[Bx, By, Bz], ...] (T)");
   }
@@ -419,10 +477,10 @@ void read_field(const TableReader& root, MessRunType type, FieldSpec& f) {
   f.sequence = sequence == "loop" ? FieldSequence::loop : FieldSequence::up;
   if (has_max || has_steps) {
     if (!has_steps) {
-      t.fail("steps", "(missing)",
+      needed(t, "steps",
              "field.max needs field.steps, the number of increments from 0 to max (integer >= 1)");
     }
-    if (!has_max) t.fail("max", "(missing)", "field.steps needs field.max (T)");
+    if (!has_max) needed(t, "max", "field.steps needs field.max (T)");
     f.form = FieldSpec::Form::max_and_steps;
     f.max = *max;
     f.steps = steps;
@@ -514,12 +572,12 @@ std::vector<double> read_load_values(const TableReader& t, const Range& max_rang
     return *values;
   }
   if (!has_max) {
-    t.fail("max", "(missing)",
+    needed(t, "max",
            fmt::format("give {0}.max and {0}.steps, or {0}.values = [0, ...]{1}", t.path(),
                        unit.empty() ? "" : fmt::format(" ({})", unit)));
   }
   if (!has_steps) {
-    t.fail("steps", "(missing)",
+    needed(t, "steps",
            fmt::format("{}.max needs {}.steps, the number of increments from 0 to max "
                        "(integer >= 1)",
                        t.path(), t.path()));
@@ -643,6 +701,12 @@ void read_solver(const std::optional<TableReader>& solver, bool demagnetization,
 // particle-count factors far beyond any real run). Past it the relaxation produces inf/NaN;
 // such parameters are refused here instead.
 constexpr double kHeadroom = 1e10;
+// The largest chi0 H/Ms of the applied field with the consistent self energy (check_load_scales).
+constexpr double kMaxSaturation = 1e12;
+// Fields up to this (T) are lab fields: past kMaxSaturation with one, chi0 is blamed instead.
+constexpr double kLabField = 1e3;
+// The largest |stress| in units of model.youngs_modulus (check_load_scales).
+constexpr double kMaxStressOverModulus = 10.0;
 
 // The largest force scale whose squares summed over `coordinates` stay finite (header above).
 double largest_scale(double coordinates) {
@@ -655,6 +719,81 @@ double largest_scale(double coordinates) {
   const auto t = root.optional_table(table);
   if (!t) throw ConfigError(fmt::format("{}.{} = {}: {}", table, key, fallback, why));
   t->fail(key, text_or(*t, key, fallback), why);
+}
+
+// The key of a [field] or [stress] table that holds the largest value (max, magnitudes or
+// values), refused with `why`.
+[[noreturn]] void refuse_load(const TableReader& t, const std::string& why) {
+  for (const char* key : {"max", "magnitudes", "values"}) {
+    if (t.has(key)) t.fail(key, t.value_text(key), why);
+  }
+  throw ConfigError(fmt::format("[{}]: {}", t.path(), why));
+}
+
+// The applied field's scales (top: the largest safe force scale, elastic: k_eff l_e): the
+// Froehlich-Kennelly argument chi0 H/Ms (eq. 4.55), and the Zeeman energy of a saturated
+// particle Ms V_p B (eq. 4.72) over R and over the elastic energy scale k_eff l_e^2 (the
+// leapfrog's units). The applied stress: the traction force on a face node ~ sigma l_e^2.
+void check_load_scales(const TableReader& root, const MessSpec& s, double top, double elastic) {
+  const double ms = s.particles.Ms;
+  const double r = s.particles.radius;
+  const double l_e = s.geometry.element_length;
+  const double zeeman_per_tesla = ms * lattice::sphere_volume(r);
+  const double overflow = std::min({top * kMu0 * ms / s.particles.chi0, top * r / zeeman_per_tesla,
+                                    top * elastic * l_e / zeeman_per_tesla});
+  // Eq. 4.76 has log(1 - |M|/Ms), and 1 - |M|/Ms = 1/(1 + chi0 H/Ms) (eq. 4.55): past
+  // chi0 H/Ms = kMaxSaturation doubles no longer resolve it (the self energy becomes NaN).
+  const double saturation = kMaxSaturation * kMu0 * ms / s.particles.chi0;
+  // (E_self of eq. 4.76 is recorded whichever particles.self_energy the solver uses.)
+  const double b_limit = std::min(overflow, saturation);
+  if (!(s.field.max <= b_limit) && b_limit == saturation && s.field.max <= kLabField) {
+    // A lab field: the material's chi0 is what is out of range.
+    refuse(root, "particles", "susceptibility", "70 (default)",
+           fmt::format("with the largest field {:g} T, chi0 H/Ms reaches {:.3g}, above {:g}, "
+                       "where 1 - |M|/Ms in the self energy's log(1 - |M|/Ms) (eq. 4.76) is "
+                       "below what doubles resolve; chi0 must be <= {:.3g} here (iron's is of "
+                       "order 1e2-1e3)",
+                       s.field.max, s.particles.chi0 * s.field.max / (kMu0 * ms), kMaxSaturation,
+                       kMaxSaturation * kMu0 * ms / s.field.max));
+  }
+  if (!(s.field.max <= b_limit)) {
+    const std::string why =
+        b_limit == overflow
+            ? fmt::format(
+                  "the Froehlich-Kennelly argument chi0 H/Ms or the Zeeman energy Ms V_p "
+                  "B = {:.3g} J of a particle is too large for the solvers' sums over the "
+                  "{} nodes to stay finite doubles",
+                  zeeman_per_tesla * s.field.max, s.geometry.node_count())
+            : fmt::format(
+                  "chi0 H/Ms exceeds {:g}, where 1 - |M|/Ms in the self energy's "
+                  "log(1 - |M|/Ms) (eq. 4.76) is below what doubles resolve",
+                  kMaxSaturation);
+    refuse_load(root.table("field"),
+                fmt::format("the largest field must be <= {:.3g} T (mu0 H): beyond it {} (lab "
+                            "fields are below 100 T)",
+                            b_limit, why));
+  }
+  if (!s.stress) return;
+  double sigma = 0.0;
+  for (const double v : s.stress->values) sigma = std::max(sigma, std::abs(v));
+  const double overflow_limit = std::min(top / (l_e * l_e), top * elastic / (l_e * l_e));
+  const double strain_limit = kMaxStressOverModulus * s.lattice.youngs_modulus;
+  if (!(sigma <= overflow_limit)) {
+    refuse_load(root.table("stress"),
+                fmt::format("the largest stress must be <= {:.3g} Pa: beyond it the traction "
+                            "force on a face node (~ stress x l_e^2, l_e = {:.3g} m) is too "
+                            "large for the solvers' sums over the {} nodes to stay finite "
+                            "doubles (the polymer's modulus is of order 1e4 Pa)",
+                            std::min(overflow_limit, strain_limit), l_e, s.geometry.node_count()));
+  }
+  if (!(sigma <= strain_limit)) {
+    refuse_load(root.table("stress"),
+                fmt::format("the largest stress must be <= {:g} x model.youngs_modulus = {:.6g} "
+                            "Pa: beyond it the engineering strain (~ stress/E) exceeds {:g}, far "
+                            "outside the lattice's small-strain springs, and the relaxation does "
+                            "not converge",
+                            kMaxStressOverModulus, strain_limit, kMaxStressOverModulus));
+  }
 }
 
 // Elastic force scale k_eff l_e (reference-notes section 2) and magnetic mu0 Ms^2 R^2 (the force
@@ -679,18 +818,21 @@ void check_scales(const TableReader& root, const MessSpec& s) {
                     "(the polymer's is of order 1e4 Pa)",
                     elastic, k.springs.edge * l_e * l_e, smallest, top, s.geometry.node_count()));
   }
-  if (s.geometry.particle_count() == 0) return;
-  const double ms = s.particles.Ms;
-  const double r = s.particles.radius;
-  const double magnetic = kMu0 * ms * ms * r * r;
-  // Also in the leapfrog's units of k_eff l_e (the scaled accelerations).
-  if (!(magnetic <= top) || !(magnetic / elastic <= top)) {
-    refuse(root, "particles", "saturation_magnetization", "1.6e6 (default)",
-           fmt::format("gives the magnetic force scale mu0 Ms^2 R^2 = {:.3g} N (energy scale "
-                       "mu0 Ms^2 R^3 = {:.3g} J), above {:.3g} N (or {:.3g} k_eff l_e), where the "
-                       "solvers' sums of squares stay finite doubles; iron's Ms is 1.6e6 A/m",
-                       magnetic, magnetic * r, top, top));
+  if (s.geometry.particle_count() > 0) {
+    const double ms = s.particles.Ms;
+    const double r = s.particles.radius;
+    const double magnetic = kMu0 * ms * ms * r * r;
+    // Also in the leapfrog's units of k_eff l_e (the scaled accelerations).
+    if (!(magnetic <= top) || !(magnetic / elastic <= top)) {
+      refuse(
+          root, "particles", "saturation_magnetization", "1.6e6 (default)",
+          fmt::format("gives the magnetic force scale mu0 Ms^2 R^2 = {:.3g} N (energy scale "
+                      "mu0 Ms^2 R^3 = {:.3g} J), above {:.3g} N (or {:.3g} k_eff l_e), where the "
+                      "solvers' sums of squares stay finite doubles; iron's Ms is 1.6e6 A/m",
+                      magnetic, magnetic * r, top, top));
+    }
   }
+  check_load_scales(root, s, top, elastic);
 }
 
 // The leapfrog is unstable for dt >= 2/omega_max of the lattice (reference-notes section 11);

@@ -18,6 +18,7 @@
 #include "mresim/mess_protocol/checkpoint.hpp"
 #include "mresim/mess_protocol/mess_outputs.hpp"
 #include "mresim/mess_protocol/protocol_runner.hpp"
+#include "mresim/pair/runs/pair_outputs.hpp"
 
 namespace mresim::mess_protocol {
 namespace {
@@ -30,12 +31,18 @@ class MessPlan final : public app::RunPlan {
   MessPlan(const config::TableReader& root, std::string_view type)
       : spec_(mc::read_mess_spec(root, type)),
         input_toml_(root.source_text()),
-        input_name_(root.source_name()) {}
+        input_name_(root.source_name()) {
+    // Refuse what cannot fit before the lattice is allocated or anything is written.
+    mc::check_memory(spec_, mc::available_memory());
+  }
 
   void describe(app::InfoReport& report) const override { mc::describe_mess(spec_, report); }
 
   void execute(const fs::path& staging_dir, io::Hdf5File& results,
                app::Progress& progress) const override {
+    // Read-time warnings: printed here, not in the constructor, so that `info` (which lists
+    // them) and a run file refused later by make_plan print only their own lines.
+    pair::runs::print_warnings(spec_.warnings);
     ProtocolRunner runner(spec_);
     const fs::path checkpoint = staging_dir / kCheckpointFile;
     ProtocolState state = fs::exists(checkpoint) ? read_checkpoint(checkpoint, runner, input_toml_)
@@ -67,6 +74,7 @@ class MessPlan final : public app::RunPlan {
     });
 
     const MessResultCheck check = write_mess_results(staging_dir, results, runner, state.records);
+    pair::runs::write_warnings_attribute(results, spec_.warnings);  // /@warnings, as pair runs
     warn_about_intermediate_solves(state.records);
     for (const std::string& fit : check.invalid_fits) {
       std::cerr << "mresim: warning: invalid modulus fit, not a result: " << fit
