@@ -181,7 +181,7 @@ struct MessGeometry {
   std::size_t particle_count() const { return centre_cells.size(); }
 };
 
-// At most this many nodes (~250 bytes each once built: springs, cells, positions); larger
+// At most this many nodes (a run needs ~1,600 bytes each: kBytesPerNode, check_memory); larger
 // boxes are rejected before anything of that size is allocated.
 inline constexpr std::int64_t kMaxNodes = 100'000'000;
 
