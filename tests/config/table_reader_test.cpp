@@ -197,6 +197,14 @@ TEST(TableReaderParse, SyntaxErrorNamesFileLineAndColumn) {
   EXPECT_EQ(message.rfind("test.toml:2:8: TOML syntax error: ", 0), 0U) << message;
 }
 
+// Found by the run-file fuzzer: the parser quotes the input up to the next line break.
+TEST(TableReaderParse, SyntaxErrorIsOneLineEvenWhenTheParserQuotesALineBreak) {
+  const std::string message = error_of([] { (void)parse("[model]\nflag = fal\nx = 1\n"); });
+  EXPECT_EQ(message.rfind("test.toml:2:", 0), 0U) << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  EXPECT_NE(message.find("expected 'false'"), std::string::npos) << message;
+}
+
 TEST(TableReaderParse, MissingFile) {
   EXPECT_EQ(error_of([] { (void)TableReader::parse_file("/nonexistent/run.toml"); }),
             "cannot read run file '/nonexistent/run.toml': No such file or directory");

@@ -130,6 +130,24 @@ bool is_table_like(const toml::node& node) {
   return a != nullptr && !a->empty() && a->is_array_of_tables();
 }
 
+// The parser's description may quote the offending input, line breaks included; an error is one
+// line (found by the run-file fuzzer: `demagnetization = fal` at the end of a line).
+std::string one_line(std::string_view text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\r') {
+      out += "\\r";
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      out += ' ';
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 TableReader::TableReader(std::shared_ptr<detail::Document> doc, const void* table, std::string path)
@@ -167,7 +185,8 @@ TableReader TableReader::parse_string(std::string_view text, std::string source_
     doc->root = toml::parse(std::string_view(doc->text), std::string_view(doc->source_name));
   } catch (const toml::parse_error& e) {
     throw ConfigError(fmt::format("{}:{}:{}: TOML syntax error: {}", doc->source_name,
-                                  e.source().begin.line, e.source().begin.column, e.description()));
+                                  e.source().begin.line, e.source().begin.column,
+                                  one_line(e.description())));
   }
   const void* root = &doc->root;
   return {std::move(doc), root, ""};
