@@ -107,6 +107,9 @@ TEST(LatticeGrid, PythonRoundingRules) {
   EXPECT_EQ(seed_spacing_voxels(28.546), 28);
   EXPECT_EQ(seed_spacing_voxels(25.926), 25);  // round(25.926, 1) = 25.9
   EXPECT_EQ(seed_spacing_voxels(25.96), 26);   // round(25.96, 1) = 26.0
+  // Beyond int's range is an error, not a wrapped (undefined) conversion; found by UBSan.
+  EXPECT_THROW((void)seed_spacing_voxels(1.4e108), std::invalid_argument);
+  EXPECT_THROW((void)seed_spacing_voxels(std::nan("")), std::invalid_argument);
 }
 
 struct D1Case {

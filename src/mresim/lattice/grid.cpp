@@ -47,7 +47,15 @@ double python_floor_divide(double a, double b) {
 }
 
 int seed_spacing_voxels(double x) {
-  return static_cast<int>(std::trunc(std::nearbyint(x * 10.0) / 10.0));
+  const double voxels = std::trunc(std::nearbyint(x * 10.0) / 10.0);
+  // Checked before the conversion: a double outside int's range is undefined behaviour (found
+  // by UBSan with volume_fraction = 5e-324).
+  if (!(voxels >= 0.0 && voxels <= std::numeric_limits<int>::max())) {
+    throw std::invalid_argument(fmt::format(
+        "gives a particle spacing of {} voxels, beyond the {} that 32-bit indices allow", voxels,
+        std::numeric_limits<int>::max()));
+  }
+  return static_cast<int>(voxels);
 }
 
 std::int64_t GridShape::node_count() const {
@@ -214,11 +222,19 @@ VolumeFractionBox box_from_volume_fraction(double particle_radius, double elemen
   }
   VolumeFractionBox box;
   box.cube_side = std::cbrt(sphere_volume(particle_radius) / volume_fraction);  // eq. 4.52
-  const int spacing = seed_spacing_voxels(box.cube_side / element_length);
+  int spacing = 0;
+  try {
+    spacing = seed_spacing_voxels(box.cube_side / element_length);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(fmt::format("volume_fraction = {} {}", volume_fraction, e.what()));
+  }
   for (int a = 0; a < 3; ++a) {
     box.lengths[a] = particles_along_axes[a] * box.cube_side * anisotropy_factor[a];
     box.shape.nodes[a] = nodes_along_axis(box.lengths[a], element_length);
-    box.spacing_voxels[a] = static_cast<int>(spacing * anisotropy_factor[a]);
+    const double spacing_along_axis = std::trunc(spacing * anisotropy_factor[a]);
+    box.spacing_voxels[a] = spacing_along_axis <= std::numeric_limits<int>::max()
+                                ? static_cast<int>(spacing_along_axis)
+                                : std::numeric_limits<int>::max();
     if (box.spacing_voxels[a] < 1) {
       throw std::invalid_argument(fmt::format(
           "volume_fraction = {} gives a particle spacing of {} voxels along axis {}; at least 1 "
