@@ -7,6 +7,7 @@
 #include <iostream>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "mresim/io/csv_writer.hpp"
@@ -16,22 +17,31 @@ namespace mresim::magnetism::runs {
 
 using config::Range;
 
+constexpr double kMaxFieldT = 1e100;
+
 namespace {
+
+LoopFeatures nan_features() {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  return {nan, nan};
+}
 
 // B_c and M_r as Fig. 1.5 marks them, read off the descending branch (loop_features.hpp); NaN
 // with a warning when the branch never crosses M = 0 or B = 0.
-LoopFeatures features_or_nan(const MagnetizationCurve& curve) {
+LoopFeatures features_or_nan(const MagnetizationCurve& curve, bool curve_finite) {
   try {
     const LoopFeatures f = loop_features(curve);
     return {f.coercive_field_t + 0.0, f.remanence + 0.0};  // + 0.0: -0 (anhysteretic) -> 0
   } catch (const std::invalid_argument& e) {
+    // A loop that never switches legitimately has no B_c or M_r; a loop with non-finite
+    // points is flagged by write_curve instead (no warning: it is an error there).
+    if (!curve_finite) return nan_features();
     std::cerr << fmt::format(
         "mresim: warning: no coercive field or remanence ({}); written as "
         "NaN. Is field.max beyond the switching fields?\n",
         e.what());
   }
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  return {nan, nan};
+  return nan_features();
 }
 
 }  // namespace
@@ -46,6 +56,14 @@ FieldSweep read_field_sweep(const config::TableReader& root, double default_max_
   }
   sweep.max_t = t->number_or("max", sweep.max_t, Range::positive(), "T");
   sweep.step_t = t->number_or("step", sweep.step_t, Range::positive(), "T");
+  // A bound on the field itself, before any derived scale: H = B / mu0 and products such as
+  // chi0 H Ms (eq. 1.5) must stay far from the largest double.
+  if (sweep.max_t > kMaxFieldT) {
+    t->fail("max", sweep.max_t,
+            fmt::format("must be <= {:.0e} T (H = B / mu0 and the products of eq. 1.5 must stay "
+                        "finite)",
+                        kMaxFieldT));
+  }
   // Same rule and wording as the two-dipole [field] (pair_setup.cpp): the grid must hit
   // 0 and +-max exactly, so the turning points and B = 0 (remanence) are sampled.
   const double steps = sweep.max_t / sweep.step_t;
@@ -71,23 +89,43 @@ void describe_field(app::InfoReport& report, const FieldSweep& sweep) {
                      "0 -> +max -> -max -> +max, 5 steps + 1");
 }
 
-void write_curve(const std::filesystem::path& staging_dir, io::Hdf5File& results,
-                 const MagnetizationCurve& curve, const CurveAttributes& attributes) {
+app::ResultCheck write_curve(const std::filesystem::path& staging_dir, io::Hdf5File& results,
+                             const MagnetizationCurve& curve, const CurveAttributes& attributes) {
   const std::size_t n = curve.b_tesla.size();
+  app::ResultCheck check("non-finite results");
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> field(curve.b_tesla);
+  std::vector<double> magnetization(curve.m_over_ms);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::string where = fmt::format("step {}", i);
+    if (!check.finite(field[i], "B_T", where)) field[i] = nan;
+    if (!check.finite(magnetization[i], "M_over_Ms",
+                      fmt::format("{} (B = {} T)", where, curve.b_tesla[i]))) {
+      magnetization[i] = nan;
+    }
+  }
   io::CsvWriter csv(staging_dir / "summary.csv", {"step", "branch", "B_T", "M_over_Ms"});
   std::vector<std::int64_t> branch(n);
   for (std::size_t i = 0; i < n; ++i) {
     branch[i] = curve.branch[i];
-    csv.row({static_cast<double>(i), static_cast<double>(curve.branch[i]), curve.b_tesla[i],
-             curve.m_over_ms[i]});
+    csv.row(
+        {static_cast<double>(i), static_cast<double>(curve.branch[i]), field[i], magnetization[i]});
   }
   csv.close();
 
-  results.write_vector("/curve/field", curve.b_tesla, "T");
+  results.write_vector("/curve/field", field, "T");
   results.write_int_vector("/curve/branch", branch);
-  results.write_vector("/curve/magnetization", curve.m_over_ms, "1");  // M/Ms
+  results.write_vector("/curve/magnetization", magnetization, "1");  // M/Ms
 
-  const LoopFeatures features = features_or_nan(curve);
+  const bool curve_finite = !check.any();
+  const LoopFeatures features = features_or_nan(curve, curve_finite);
+  if (curve_finite) {
+    // Features of a finite curve are finite when they exist; NaN here is the no-crossing case.
+    if (std::isinf(features.coercive_field_t)) check.flag("coercive_field_T", "/curve");
+    if (std::isinf(features.remanence)) check.flag("remanence", "/curve");
+  } else {
+    check.flag("coercive_field_T and remanence", "/curve (from a non-finite curve)");
+  }
   results.write_number_attribute("/curve", "coercive_field_T", features.coercive_field_t);
   results.write_number_attribute("/curve", "remanence", features.remanence);
   results.write_number_attribute("/curve", "saturation_magnetization_A_per_m",
@@ -96,6 +134,7 @@ void write_curve(const std::filesystem::path& staging_dir, io::Hdf5File& results
     results.write_number_attribute("/curve", "initial_susceptibility",
                                    attributes.initial_susceptibility);
   }
+  return check;
 }
 
 }  // namespace mresim::magnetism::runs

@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "mresim/app/info_report.hpp"
+#include "mresim/app/invalid_results.hpp"
 #include "mresim/config/table_reader.hpp"
 #include "mresim/io/hdf5_file.hpp"
 #include "mresim/magnetism/magnetization_curve.hpp"
@@ -26,8 +27,8 @@ struct FieldSweep {
   [[nodiscard]] double grid_step_t() const { return max_t / static_cast<double>(steps); }
 };
 
-// Reads the optional [field] table (max > 0, default `default_max_t`; step > 0, default 0.01 T;
-// max a whole number of steps, at most 1e6 of them). Throws config::ConfigError.
+// Reads the optional [field] table (max in (0, 1e100] T, default `default_max_t`; step > 0, default
+// 0.01 T; max a whole number of steps, at most 1e6 of them). Throws config::ConfigError.
 FieldSweep read_field_sweep(const config::TableReader& root, double default_max_t);
 
 // The [field] lines of `mresim info`: max, step, steps per branch, samples.
@@ -43,8 +44,12 @@ struct CurveAttributes {
 // /curve/branch, /curve/magnetization into `results`, with the /curve attributes
 // coercive_field_T and remanence (from loop_features) plus `attributes`. If the descending
 // branch never crosses B = 0 or M = 0 (a minor loop that never switches), the coercive field
-// and remanence are written as NaN and a warning goes to stderr.
-void write_curve(const std::filesystem::path& staging_dir, io::Hdf5File& results,
-                 const MagnetizationCurve& curve, const CurveAttributes& attributes);
+// and remanence are written as NaN and a warning goes to stderr. Non-finite points (overflow)
+// are written as NaN and collected in the returned check, which the run type throws at the end
+// of execute() (app::InvalidResults, exit status 4).
+// Reading also bounds field.max to <= 1e100 T.
+[[nodiscard]] app::ResultCheck write_curve(const std::filesystem::path& staging_dir,
+                                           io::Hdf5File& results, const MagnetizationCurve& curve,
+                                           const CurveAttributes& attributes);
 
 }  // namespace mresim::magnetism::runs

@@ -3,6 +3,8 @@
 //
 //   [material]  susceptibility = 70, saturation_magnetization = 1.6e6 (A/m)
 //   [field]     max = 1.0 (T), step = 0.01 (T)
+#include <fmt/format.h>
+
 #include <memory>
 
 #include "mresim/app/run_type.hpp"
@@ -15,12 +17,28 @@ namespace {
 
 using config::Range;
 
+constexpr double kMaxParameter = 1e60;  // bound on chi0 and on Ms (A/m)
+
 class FroehlichKennellyPlan final : public app::RunPlan {
  public:
   explicit FroehlichKennellyPlan(const config::TableReader& root) {
     if (const auto t = root.optional_table("material")) {
       chi0_ = t->number_or("susceptibility", chi0_, Range::positive(), "");
       ms_ = t->number_or("saturation_magnetization", ms_, Range::positive(), "A/m");
+      // Eq. 1.5 multiplies Ms chi0 H; with field.max <= 1e100 T (H <= 8e105 A/m) these bounds
+      // keep that product below 1e226, far from overflow.
+      if (chi0_ > kMaxParameter) {
+        t->fail("susceptibility", chi0_,
+                fmt::format("must be <= {:.0e} (eq. 1.5 multiplies chi0 H Ms, which would "
+                            "overflow)",
+                            kMaxParameter));
+      }
+      if (ms_ > kMaxParameter) {
+        t->fail("saturation_magnetization", ms_,
+                fmt::format("must be <= {:.0e} A/m (eq. 1.5 multiplies chi0 H Ms, which would "
+                            "overflow)",
+                            kMaxParameter));
+      }
     }
     sweep_ = read_field_sweep(root, 1.0);
   }
@@ -45,7 +63,8 @@ class FroehlichKennellyPlan final : public app::RunPlan {
     const MagnetizationCurve curve =
         froehlich_kennelly_loop(chi0_, ms_, sweep_.max_t, sweep_.grid_step_t());
     progress.advance();
-    write_curve(staging_dir, results, curve, {ms_, chi0_});
+    const app::ResultCheck check = write_curve(staging_dir, results, curve, {ms_, chi0_});
+    check.throw_if_any("written as NaN in summary.csv and /curve");
   }
 
  private:

@@ -85,7 +85,8 @@ class PreisachPlan final : public app::RunPlan {
     }
     // The relay model is normalized (sum of weights 1): it has no Ms in A/m.
     const double nan = std::numeric_limits<double>::quiet_NaN();
-    write_curve(staging_dir, results, curve, {nan, nan});
+    const app::ResultCheck check = write_curve(staging_dir, results, curve, {nan, nan});
+    check.throw_if_any("written as NaN in summary.csv and /curve");
   }
 
  private:

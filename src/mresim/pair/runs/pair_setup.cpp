@@ -73,6 +73,8 @@ namespace {
 // Lengths handled by the solver in units of R are squared and raised to the 7th power (the
 // dipole gradient); beyond this ratio to R their squares approach the largest double.
 constexpr double kMaxReducedLength = 1e100;
+// Bound on field.max in units of the saturation field mu0 Ms (validate_field_magnitude).
+constexpr double kMaxReducedField = 1e6;
 constexpr double kSmallest = std::numeric_limits<double>::min();
 constexpr double kLargest = std::numeric_limits<double>::max();
 
@@ -184,6 +186,21 @@ void read_field(const TableReader& t, SweepOptions& sweep) {
 
 // A positive, finite double that is not subnormal (and not 0 after underflow).
 bool normal_positive(double x) { return std::isfinite(x) && x >= kSmallest; }
+
+// The field itself, before anything derived from it (the critical-field tolerance, the reduced
+// scales): at most kMaxReducedField saturation fields mu0 Ms. The pair saturates at a few
+// mu0 Ms; a sweep far beyond that only makes the Zeeman energy swamp every other term (the
+// solver failed from about 1e27 mu0 Ms on: "coincident sphere centres", invalid critical fields).
+void validate_field_magnitude(const TableReader& scope, const PairSetup& s) {
+  const double limit = kMaxReducedField * kMu0 * s.material.saturation_magnetization;
+  if (s.sweep.b_max > limit) {
+    fail_in(scope, "field", "max", s.sweep.b_max,
+            fmt::format("must be <= {:.0e} mu0 Ms = {:.6g} T at Ms = {:.6g} A/m (the pair is "
+                        "saturated long before; far beyond, the Zeeman energy swamps every other "
+                        "term of the solver)",
+                        kMaxReducedField, limit, s.material.saturation_magnetization));
+  }
+}
 
 // The energy unit mu0 Ms^2 V and the length unit R of the solver (pair_energy.hpp) must be
 // normal doubles, or every reduced quantity becomes 0, inf or NaN.
@@ -316,6 +333,7 @@ PairSetup read_pair_setup(const TableReader& scope, const PairSetup& base, bool 
   }
   if (auto t = scope.optional_table("penalty")) read_penalty(*t, s);
   if (auto t = scope.optional_table("field")) read_field(*t, s.sweep);
+  validate_field_magnitude(scope, s);
   if (auto t = scope.optional_table("solver")) {
     const std::string current =
         s.sweep.relax.method == RelaxMethod::newton ? "newton" : "conjugate_gradient";
