@@ -114,6 +114,33 @@ INSTANTIATE_TEST_SUITE_P(
                 "scale k S0^2"},
         Refused{"HugePenalty", kLoop + "[penalty]\ne_max = 1e300\n",
                 "penalty.e_max = 1e+300: is inf times the magnetic energy scale"},
+        // field.max is bounded in saturation fields before step and tolerance are checked
+        // against it (before: exit 1 "coincident sphere centres", or critical_fields.tolerance
+        // blamed).
+        Refused{"FieldMaxFarBeyondSaturation", replaced(kLoop, "max = 0.1", "max = 1e308"),
+                "field.max = 1e+308: must be <= 1e+06 mu0 Ms = 1.75929e+06 T at Ms = 1.4e+06 "
+                "A/m (the pair is saturated long before; far beyond, the Zeeman energy swamps "
+                "every other term of the solver)"},
+        Refused{"FieldMaxBeforeTolerance",
+                replaced(kLoop, "max = 0.1\nstep = 0.01", "max = 1e308\nstep = 1e306") +
+                    "[critical_fields]\ntolerance = 1e-4\n",
+                "field.max = 1e+308: must be <= 1e+06 mu0 Ms"},
+        Refused{"FieldMaxJustAboveTheBound",
+                replaced(kLoop, "max = 0.1\nstep = 0.01", "max = 1.8e6\nstep = 1e5"),
+                "field.max = 1800000: must be <= 1e+06 mu0 Ms = 1.75929e+06 T"},
+        Refused{"FieldMaxForSmallerMsInACase",
+                replaced(kLoop, "max = 0.1\nstep = 0.01", "max = 1e5\nstep = 1e4") +
+                    "[[case]]\nlabel = \"soft\"\n[case.material]\nsaturation_magnetization = "
+                    "1e4\n",
+                "case[0].field.max = 100000: must be <= 1e+06 mu0 Ms = 12566.4 T at Ms = 10000 "
+                "A/m"},
+        Refused{"MapFieldMax",
+                replaced(kMap, "max = 0.1\nstep = 0.01", "max = 1e308\nstep = 1e302") +
+                    "[critical_fields]\ntolerance = 1e-4\n",
+                "field.max = 1e+308: must be <= 1e+06 mu0 Ms"},
+        Refused{"EnsembleFieldMax",
+                replaced(kEnsemble, "max = 0.1\nstep = 0.01", "max = 1e308\nstep = 1e307"),
+                "field.max = 1e+308: must be <= 1e+06 mu0 Ms"},
         Refused{"EnsembleMeanInMicrometres", replaced(kEnsemble, "mean = 4.8e-6", "mean = 4.8"),
                 "ensemble.mean = 4.8: the Gaussian weights exp(-(S0 - mean)^2 / (2 sd^2)) with "
                 "mean = 4.8 m, standard_deviation = 6.5e-06 m vanish at every separation from "
@@ -133,7 +160,9 @@ TEST(PairScaleErrors, CommandLineRefusesThemWithStatus2) {
        "mresim: error: springs.rest_separation = 1e+150: "},
       {kLoop + "[material]\nradius = 1e-300\n", "mresim: error: material.radius = 1e-300: "},
       {replaced(kMap, "separation_max = 12e-6", "separation_max = 1e200"),
-       "mresim: error: map.separation_max = 1e+200: "}};
+       "mresim: error: map.separation_max = 1e+200: "},
+      {replaced(kLoop, "max = 0.1\nstep = 0.01", "max = 1e308\nstep = 1e307"),
+       "mresim: error: field.max = 1e+308: must be <= 1e+06 mu0 Ms"}};
   for (const auto& [text, prefix] : files) {
     const mresim::testing::TempDir dir;
     mresim::testing::write_text(dir / "bad.toml", text);

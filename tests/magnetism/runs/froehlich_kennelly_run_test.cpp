@@ -159,6 +159,32 @@ TEST(FroehlichKennellyRun, RejectsInvalidInput) {
             "unknown table [preisach]; allowed: field, material, run");
 }
 
+// Values whose products in eq. 1.5 (chi0 H Ms, H = B / mu0) overflow: before the fix these ran
+// and wrote B_T = inf, M_over_Ms = NaN with only a warning.
+TEST(FroehlichKennellyRun, RejectsParametersThatOverflowEquation15) {
+  EXPECT_EQ(error_of("[field]\nmax = 1e308\nstep = 1e302\n"),
+            "field.max = 1e+308: must be <= 1e+100 T (H = B / mu0 and the products of eq. 1.5 "
+            "must stay finite)");
+  EXPECT_EQ(error_of("[material]\nsaturation_magnetization = 1e308\n"),
+            "material.saturation_magnetization = 1e+308: must be <= 1e+60 A/m (eq. 1.5 "
+            "multiplies chi0 H Ms, which would overflow)");
+  EXPECT_EQ(error_of("[material]\nsusceptibility = 1e308\n"),
+            "material.susceptibility = 1e+308: must be <= 1e+60 (eq. 1.5 multiplies chi0 H Ms, "
+            "which would overflow)");
+  // The bounds themselves still give a finite curve.
+  TempDir dir;
+  const auto plan = plan_of(
+      "[material]\nsusceptibility = 1e60\nsaturation_magnetization = 1e60\n"
+      "[field]\nmax = 1e100\nstep = 1e99\n");
+  io::Hdf5File results(dir / "results.h5");
+  app::Progress progress(0, "test", {nullptr, false, 0.5});
+  EXPECT_NO_THROW(plan->execute(dir.path(), results, progress));
+  results.close();
+  for (const double m : Hdf5Reader(dir / "results.h5").doubles("/curve/magnetization")) {
+    EXPECT_TRUE(std::isfinite(m));
+  }
+}
+
 TEST(FroehlichKennellyRun, AcceptsStepsThatDivideMaxUpToRounding) {
   // 0.3 / 0.1 = 2.9999999999999996 in binary: still exactly three steps.
   const nlohmann::json info = info_of("[field]\nmax = 0.3\nstep = 0.1\n");

@@ -178,6 +178,9 @@ TEST(PreisachRun, RejectsInvalidInput) {
             "0, +max, -max exactly)");
   EXPECT_EQ(error_of("[material]\nsusceptibility = 70\n"),
             "unknown table [material]; allowed: field, preisach, run");
+  EXPECT_EQ(error_of("[field]\nmax = 1e308\nstep = 1e302\n"),
+            "field.max = 1e+308: must be <= 1e+100 T (H = B / mu0 and the products of eq. 1.5 "
+            "must stay finite)");
 }
 
 }  // namespace

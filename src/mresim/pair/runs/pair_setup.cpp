@@ -159,22 +159,6 @@ void read_penalty(const TableReader& t, PairSetup& s) {
   p.r_cut = t.number_or("r_cut", default_cut, Range::positive(), "m");
 }
 
-void read_field(const TableReader& t, SweepOptions& sweep) {
-  sweep.b_max = t.number_or("max", sweep.b_max, Range::positive(), "T");
-  sweep.b_step = t.number_or("step", sweep.b_step, Range::positive(), "T");
-  sweep.theta_h_deg = t.number_or("angle", sweep.theta_h_deg, Range::between(0.0, 90.0), "deg");
-  const double steps = sweep.b_max / sweep.b_step;
-  if (std::abs(steps - std::round(steps)) > 1e-6 * steps) {
-    t.fail("max", sweep.b_max,
-           fmt::format("must be a whole number of field.step = {} T (the sweep visits "
-                       "0, +max, -max exactly)",
-                       sweep.b_step));
-  }
-  if (std::round(steps) > 1e6) {
-    t.fail("step", sweep.b_step, "must give at most 1e6 steps up to field.max");
-  }
-}
-
 // Fails on `table`.`key` of `scope`, naming the full dotted key even when `scope` does not
 // contain that table (a [[case]] inheriting the value from the root).
 [[noreturn]] void fail_in(const TableReader& scope, const std::string& table,
@@ -199,6 +183,24 @@ void validate_field_magnitude(const TableReader& scope, const PairSetup& s) {
                         "saturated long before; far beyond, the Zeeman energy swamps every other "
                         "term of the solver)",
                         kMaxReducedField, limit, s.material.saturation_magnetization));
+  }
+}
+
+void read_field(const TableReader& scope, const TableReader& t, PairSetup& s) {
+  SweepOptions& sweep = s.sweep;
+  sweep.b_max = t.number_or("max", sweep.b_max, Range::positive(), "T");
+  validate_field_magnitude(scope, s);  // before step and tolerance: they are relative to max
+  sweep.b_step = t.number_or("step", sweep.b_step, Range::positive(), "T");
+  sweep.theta_h_deg = t.number_or("angle", sweep.theta_h_deg, Range::between(0.0, 90.0), "deg");
+  const double steps = sweep.b_max / sweep.b_step;
+  if (std::abs(steps - std::round(steps)) > 1e-6 * steps) {
+    t.fail("max", sweep.b_max,
+           fmt::format("must be a whole number of field.step = {} T (the sweep visits "
+                       "0, +max, -max exactly)",
+                       sweep.b_step));
+  }
+  if (std::round(steps) > 1e6) {
+    t.fail("step", sweep.b_step, "must give at most 1e6 steps up to field.max");
   }
 }
 
@@ -332,8 +334,8 @@ PairSetup read_pair_setup(const TableReader& scope, const PairSetup& base, bool 
                                               : OverlapPenalty::tanh_default(s.material.radius);
   }
   if (auto t = scope.optional_table("penalty")) read_penalty(*t, s);
-  if (auto t = scope.optional_table("field")) read_field(*t, s.sweep);
-  validate_field_magnitude(scope, s);
+  if (auto t = scope.optional_table("field")) read_field(scope, *t, s);
+  validate_field_magnitude(scope, s);  // also when a [[case]] changes Ms but not the field
   if (auto t = scope.optional_table("solver")) {
     const std::string current =
         s.sweep.relax.method == RelaxMethod::newton ? "newton" : "conjugate_gradient";
