@@ -24,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "../support/child_process.hpp"
 #include "../support/temp_dir.hpp"
 
 namespace {
@@ -133,25 +134,7 @@ Outcome run_mresim(const fs::path& work, const std::vector<std::string>& args) {
   const TempDir capture;
   const std::string out_file = (capture / "stdout").string();
   const std::string err_file = (capture / "stderr").string();
-  std::vector<std::string> words = {MRESIM_CLI_PATH};
-  words.insert(words.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  argv.reserve(words.size() + 1);
-  for (auto& w : words) argv.push_back(w.data());
-  argv.push_back(nullptr);
-
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    const int in = ::open("/dev/null", O_RDONLY);
-    const int out = ::open(out_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-    const int err = ::open(err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-    if (in < 0 || out < 0 || err < 0 || ::chdir(work.c_str()) != 0) ::_exit(127);
-    ::dup2(in, 0);
-    ::dup2(out, 1);
-    ::dup2(err, 2);
-    ::execv(argv[0], argv.data());
-    ::_exit(127);
-  }
+  const pid_t pid = mresim::testing::start_child(MRESIM_CLI_PATH, args, work, out_file, err_file);
   Outcome result;
   if (pid < 0) return result;
   const auto deadline = std::chrono::steady_clock::now() + kTimeout;

@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "../support/child_process.hpp"
 #include "../support/hdf5_read.hpp"
 #include "../support/temp_dir.hpp"
 
@@ -30,27 +31,12 @@ using mresim::testing::write_text;
 constexpr const char* kSlowRun =
     "[run]\ntype = \"test_dummy\"\n[dummy]\nsteps = 20\nstep_seconds = 0.1\n";
 
-// `mresim_testbed args...` in `dir` in the background, stdout and stderr to files in `dir`.
+// `mresim_testbed args...` in `dir` in the background, stdout and stderr to <tag>.out/.err.
 pid_t start(const fs::path& dir, const std::vector<std::string>& args, const std::string& tag) {
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    if (::chdir(dir.c_str()) != 0) ::_exit(127);
-    if (std::freopen((tag + ".out").c_str(), "w", stdout) == nullptr) ::_exit(127);
-    if (std::freopen((tag + ".err").c_str(), "w", stderr) == nullptr) ::_exit(127);
-    std::vector<char*> argv{const_cast<char*>("mresim")};
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    ::execv(MRESIM_TESTBED_PATH, argv.data());
-    ::_exit(127);
-  }
-  return pid;
+  return mresim::testing::start_child(MRESIM_TESTBED_PATH, args, dir, tag + ".out", tag + ".err");
 }
 
-int wait_for(pid_t pid) {
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
+int wait_for(pid_t pid) { return mresim::testing::wait_child(pid); }
 
 // Waits until `path` exists (the run has claimed its directory); false after 30 s.
 bool appears(const fs::path& path) {

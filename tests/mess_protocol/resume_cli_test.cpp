@@ -16,6 +16,7 @@
 #include <string>
 #include <thread>
 
+#include "../support/child_process.hpp"
 #include "../support/hdf5_read.hpp"
 #include "../support/temp_dir.hpp"
 #include "small_runs.hpp"
@@ -38,18 +39,7 @@ int mresim_status(const fs::path& dir, const std::string& args) {
 // `dir`/.stderr-<tag>).
 pid_t start_mresim(const fs::path& dir, const std::vector<std::string>& args,
                    const std::string& tag = "bg") {
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    if (::chdir(dir.c_str()) != 0) ::_exit(127);
-    if (std::freopen("/dev/null", "w", stdout) == nullptr) ::_exit(127);
-    if (std::freopen((".stderr-" + tag).c_str(), "w", stderr) == nullptr) ::_exit(127);
-    std::vector<char*> argv{const_cast<char*>("mresim")};
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    ::execv(MRESIM_CLI_PATH, argv.data());
-    ::_exit(127);
-  }
-  return pid;
+  return mresim::testing::start_child(MRESIM_CLI_PATH, args, dir, "/dev/null", ".stderr-" + tag);
 }
 
 // Starts `mresim run FILE --out OUT --no-plot -j 2` in `dir` without waiting for it.
@@ -70,11 +60,7 @@ void expect_identical_steps(const fs::path& a_dir, const fs::path& b_dir) {
   EXPECT_EQ(a.ints("/steps/solver/iterations"), b.ints("/steps/solver/iterations"));
 }
 
-int exit_status_of(pid_t pid) {
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
+int exit_status_of(pid_t pid) { return mresim::testing::wait_child(pid); }
 
 // The checkpoint of the running process's staging directory, once it exists.
 fs::path staged_checkpoint(const fs::path& dir, const std::string& out) {
