@@ -171,6 +171,69 @@ TEST(TwoDipoleThreeSprings, ConjugateGradientsAgreeWithNewtonOverAngleAndSeparat
   }
 }
 
+PairSystem fig29_pair(double s0) {
+  PairSystem p;
+  const PuljizStiffness k = puljiz_stiffness(1375.0, kR, s0);
+  p.springs = {SpringModel::three, k.k12, k.k0, s0};
+  p.penalty = OverlapPenalty::wca_default(kR);
+  return p;
+}
+
+// Defect: a three-spring pair clustered on the WCA cut-off in an oblique field stopped
+// unconverged. The saddle-free Newton step there (the outside's negative radial curvature)
+// heads into the wall and every fraction of it raises the energy, while the rotation was still
+// off; the pair must roll along the contact sphere at fixed S to its minimum. It must end at the
+// same state as a relaxation that approaches the wall from outside.
+TEST(TwoDipoleThreeSprings, ClusteredPairRollsAlongTheWcaWallToItsMinimum) {
+  struct Case {
+    double angle, s0, b;
+    Eigen::Vector3d start;  // m: a bisection's start that stopped unconverged
+  };
+  // A clustered state near H_C1, and a separated state past the end of its branch (it falls
+  // onto the wall and must then roll).
+  for (const Case& c :
+       {Case{
+            60.0, 7e-6, 0.21414062499999997, {2.9408533947524827e-06, 0.0, 1.6403264186211973e-06}},
+        Case{5.0,
+             4.2e-6,
+             0.10500000000000001,
+             {3.7171572063629644e-06, 0.0, 7.0242294766782196e-08}}}) {
+    const PairSystem p = fig29_pair(c.s0);
+    const Eigen::Vector3d direction = field_direction(c.angle);
+    const PairState s = relax_at_field(p, c.b, direction, c.start, {});
+    EXPECT_TRUE(s.converged) << c.angle;
+    EXPECT_NEAR(s.separation.norm(), p.penalty.r_cut, 1e-9 * kR) << c.angle;  // on the wall
+    // Rotational force at the end: dE/dtheta = S t.g (scaled), resolved to the tolerance.
+    const PairEnergy energy(p, c.b * direction);
+    const Eigen::Vector3d d = s.separation / kR;
+    Eigen::Vector3d g;
+    energy.scaled_energy_and_gradient(d, g);
+    EXPECT_LT(std::abs(Eigen::Vector3d(-d.z(), 0.0, d.x()).dot(g)), 1e-10) << c.angle;
+  }
+}
+
+// The Fig. 2.9 cells (theta_H, S0) whose bisections stopped at such states: every relaxation
+// converges and the critical fields are the ones published before the convergence check became
+// strict (tolerance 1e-4 T).
+TEST(TwoDipoleThreeSprings, Figure29CellsOnTheWcaWallConvergeWithUnchangedFields) {
+  struct Cell {
+    double angle, s0, hc1, hc2;
+  };
+  for (const Cell c : {Cell{5.0, 4.2e-6, 0.1041015625, 0.1047265625},
+                       Cell{15.0, 4.8e-6, 0.1308984375, 0.1469140625},
+                       Cell{60.0, 7e-6, 0.2141015625, 0.5380078125},
+                       Cell{90.0, 3.2e-6, 0.1473046875, 0.1649609375}}) {
+    SweepOptions sweep;
+    sweep.theta_h_deg = c.angle;
+    const CriticalFields cf = critical_fields_of(fig29_pair(c.s0), sweep);
+    const std::string where = std::to_string(c.angle) + " deg, S0 = " + std::to_string(c.s0);
+    ASSERT_TRUE(cf.hysteresis) << where;
+    EXPECT_TRUE(cf.valid()) << where << ": " << cf.problem;
+    EXPECT_NEAR(cf.hc1, c.hc1, 1e-4) << where;
+    EXPECT_NEAR(cf.hc2, c.hc2, 1e-4) << where;
+  }
+}
+
 // Defect: a tolerance below double precision never ended the bisection. Called directly (no
 // run-file validation), it must end at the finest bracket the arithmetic allows and say so.
 TEST(CriticalFieldBisection, EndsWhenTheToleranceIsBelowDoublePrecision) {

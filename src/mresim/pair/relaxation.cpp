@@ -10,11 +10,6 @@
 namespace mresim::pair {
 namespace {
 
-// Round-off of the scaled energy e.
-double roundoff(double e) {
-  return 8.0 * std::numeric_limits<double>::epsilon() * (1.0 + std::abs(e));
-}
-
 template <int N>
 struct NewtonStep {
   using Mat = typename detail::PolarCoordinates<N>::Mat;
@@ -97,6 +92,40 @@ bool line_search(const Evaluate& evaluate, const NewtonStep<N>& newton, const Re
   return false;
 }
 
+// Newton step along the rotation alone, for a three-spring pair resting on the WCA wall. There
+// the saddle-free step fails: at q (on the cut-off, a few ulps from the radial minimum) the
+// radial curvature is the outside's, negative with the attraction, so the step heads into the
+// wall along an eigenvector that mixes S and theta, and every fraction of it raises the energy.
+// The radial coordinate is then at its minimum to the ulp (its gradient changes sign within a
+// few ulps inwards) but the rotation may still be off by a few 1e-4 rad near a critical field:
+// the pair must roll along the contact sphere at fixed S. (Not a fold: in the Fig. 2.9 cells
+// that stopped here the minimum exists on the wall, and rolling reaches it with the critical
+// fields unchanged; docs/two-dipole-model.md.) Returns whether a step was taken.
+template <int N, typename Evaluate, typename Vec>
+bool roll_on_wall(const Evaluate& evaluate, const NewtonStep<N>& newton, const RelaxOptions& opt,
+                  Vec& q, Vec& g, Eigen::Vector3d& g3, double& e) {
+  if constexpr (N == 1) {
+    return false;
+  } else {
+    if (std::abs(g(1)) < opt.gradient_tolerance) return false;  // nothing left to roll
+    bool pinned = false;  // the radial gradient vanishes or changes sign within 256 ulps
+    for (const double ulps : {4.0, 32.0, 256.0}) {
+      const detail::Probe<N> p =
+          detail::probe_minimum<N>(q, g, Vec::Zero(), opt.gradient_tolerance, evaluate, ulps);
+      pinned =
+          pinned || std::abs(p.gradient(0)) < opt.gradient_tolerance || g(0) * p.gradient(0) <= 0.0;
+    }
+    if (!pinned) return false;
+    NewtonStep<N> rolling = newton;
+    const double c = newton.hessian(1, 1);
+    rolling.step = Vec(0.0, c > newton.floor ? -g(1) / c : -std::copysign(opt.max_step, g(1)));
+    // Radial row and column out of the line search's progress measure (S does not move).
+    rolling.hessian(0, 1) = rolling.hessian(1, 0) = 0.0;
+    rolling.hessian(0, 0) = std::numeric_limits<double>::infinity();
+    return line_search<N>(evaluate, rolling, opt, q, g, g3, e);
+  }
+}
+
 template <int N>
 RelaxResult newton(const PairEnergy& energy, const Eigen::Vector3d& start_scaled,
                    const RelaxOptions& opt) {
@@ -150,6 +179,7 @@ RelaxResult newton(const PairEnergy& energy, const Eigen::Vector3d& start_scaled
       }
     }
     if (!line_search<N>(evaluate, newton, opt, q, g, g3, e)) {
+      if (roll_on_wall<N>(evaluate, newton, opt, q, g, g3, e)) continue;
       // No step is accepted: the minimum may lie within a few ulps of q where the curvature
       // at q (negative just past the WCA's edge) does not describe it; verify that.
       result.converged =
