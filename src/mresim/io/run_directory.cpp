@@ -96,12 +96,14 @@ void RunDirectory::create_parents() {
     missing.push_back(p);
     if (p == p.parent_path()) break;
   }
-  for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
-    if (!fs::create_directory(*it, ec) && ec) {
+  while (!missing.empty()) {  // outermost first
+    const fs::path dir = missing.back();
+    missing.pop_back();
+    if (!fs::create_directory(dir, ec) && ec) {
       throw OutputDirectoryError(
-          fmt::format("cannot create output directory '{}': {}", it->string(), ec.message()));
+          fmt::format("cannot create output directory '{}': {}", dir.string(), ec.message()));
     }
-    created_parents_.insert(created_parents_.begin(), *it);  // deepest first
+    created_parents_.insert(created_parents_.begin(), dir);  // deepest first
   }
 }
 
@@ -160,7 +162,7 @@ RunDirectory::RunDirectory(const fs::path& final_dir, Options options) {
   }
 }
 
-RunDirectory::RunDirectory(const fs::path& final_dir, ForResume) {
+RunDirectory::RunDirectory(const fs::path& final_dir, ForResume /*tag*/) {
   try {
     claim_final(final_dir, "mresim resume");
   } catch (...) {

@@ -82,7 +82,7 @@ class RunDirectory {
 
  private:
   struct ForResume {};
-  RunDirectory(const std::filesystem::path& final_dir, ForResume);
+  RunDirectory(const std::filesystem::path& final_dir, ForResume tag);
 
   void claim_final(const std::filesystem::path& final_dir, const std::string& command);
   void check_replaceable(bool force);

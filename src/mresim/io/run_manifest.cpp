@@ -89,7 +89,7 @@ std::vector<fs::path> unlisted_entries(const fs::path& dir) {
     const std::string relative = it->path().lexically_relative(dir).generic_string();
     if (relative == kFileName) continue;
     const bool is_dir = it->is_directory(ec) && !it->is_symlink(ec);
-    if (is_dir ? listed_dirs.count(relative) > 0 : listed.count(relative) > 0) continue;
+    if (is_dir ? listed_dirs.contains(relative) : listed.contains(relative)) continue;
     unlisted.emplace_back(relative);
     if (is_dir) it.disable_recursion_pending();  // its contents are unlisted with it
   }

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-namespace mresim::io {
+namespace mresim::io::run_manifest {
 
 // The list of files mresim wrote into a run directory, kept in the directory itself as
 // ".mresim-manifest" (one relative path per line after a header line).
@@ -13,7 +13,6 @@ namespace mresim::io {
 // it has a manifest and holds nothing the manifest does not list. A file the user added (notes,
 // the run file, a thesis draft) or a directory that merely contains something named results.h5
 // is never deleted.
-namespace run_manifest {
 
 inline constexpr const char* kFileName = ".mresim-manifest";
 
@@ -34,5 +33,4 @@ bool exists(const std::filesystem::path& dir);
 // every entry.
 std::vector<std::filesystem::path> unlisted_entries(const std::filesystem::path& dir);
 
-}  // namespace run_manifest
-}  // namespace mresim::io
+}  // namespace mresim::io::run_manifest
