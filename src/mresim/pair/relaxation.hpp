@@ -34,7 +34,10 @@ struct RelaxResult {
 // rotation angle theta in the plane of the field and the zero-field axis. Method: Newton's
 // method on the exact gradient, negative curvature flipped to descend (saddle-free Newton),
 // steps capped at max_step and accepted by an Armijo line search, so the energy never increases
-// and a pair cannot tunnel through the overlap penalty. (The text used nonlinear conjugate
+// and a pair cannot tunnel through the overlap penalty. A state counts as converged only when
+// the gradient is below tolerance or verified to change sign across the minimum (no false
+// convergence at the WCA wall); a three-spring pair resting on the wall whose step into it is
+// rejected rolls at fixed S until the rotation converges. (The text used nonlinear conjugate
 // gradients; Newton reaches the same local minimum in a handful of iterations.)
 RelaxResult relax(const PairEnergy& energy, SpringModel model, const Eigen::Vector3d& start,
                   const RelaxOptions& options = {});
