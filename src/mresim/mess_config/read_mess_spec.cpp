@@ -796,8 +796,9 @@ void check_load_scales(const TableReader& root, const MessSpec& s, double top, d
   }
 }
 
-// Elastic force scale k_eff l_e (reference-notes section 2) and magnetic mu0 Ms^2 R^2 (the force
-// between two saturated particles at contact, eq. 4.71 over R; energy scale mu0 Ms^2 R^3).
+// Elastic force scale k_eff l_e (the seed's characteristic spring force, docs/lattice.md) and
+// magnetic mu0 Ms^2 R^2 (the force between two saturated particles at contact, eq. 4.71 over R;
+// energy scale mu0 Ms^2 R^3).
 void check_scales(const TableReader& root, const MessSpec& s) {
   const lattice::LatticeSpec& l = s.lattice;
   const double l_e = s.geometry.element_length;
@@ -835,7 +836,7 @@ void check_scales(const TableReader& root, const MessSpec& s) {
   check_load_scales(root, s, top, elastic);
 }
 
-// The leapfrog is unstable for dt >= 2/omega_max of the lattice (reference-notes section 11);
+// The leapfrog is unstable for dt >= 2/omega_max of the lattice (docs/mess-solvers.md);
 // omega_max is known for the seed profile at n_d = 2..5 (leapfrog_stability_limit).
 void check_leapfrog(const std::optional<TableReader>& solver, const MessSpec& s) {
   if (s.solver.method != SolverMethod::leapfrog || s.lattice.profile != lattice::Profile::seed) {
@@ -859,7 +860,7 @@ void check_leapfrog(const std::optional<TableReader>& solver, const MessSpec& s)
 // ------------------------------------------------------------------------------------ public
 
 std::optional<double> leapfrog_stability_limit(int discretization_order) {
-  // reference-notes section 11: power iteration on the seed lattice's force Jacobian.
+  // Measured by power iteration on the seed lattice's force Jacobian (docs/mess-solvers.md).
   switch (discretization_order) {
     case 2:
       return 4.8e-3;
