@@ -213,7 +213,7 @@ def _angles(b):
 
 def legs(field):
     """Leg index per step: a new leg starts after every point where |B| is at its maximum (the
-    turning points of a loop; reference-notes section 19)."""
+    turning points of a loop; docs/original-code.md#hysteresis-figures)."""
     a = np.abs(field)
     top = np.max(a)
     if top <= 0:

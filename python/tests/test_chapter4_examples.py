@@ -31,7 +31,8 @@ CHAPTER4 = os.path.join(REPO, "examples", "chapter4")
 SMALL = os.path.join(CHAPTER4, "small")
 MESS_TYPES = ("mess_hysteresis", "mess_strain", "mess_magnetostriction", "mess_stress")
 
-# Published node counts (seed-claims D1) of the files the dissertation states them for.
+# Published node counts (claim D1, docs/validation.md#claims-d1-d13) of the files the dissertation
+# states them for.
 EXPECTED_NODES = {"fig4_4_": 146412, "fig4_5_": 52200}
 
 
