@@ -2,7 +2,7 @@
 
 // Shared parts of the single-particle magnetization-curve run types of Chapter 1
 // (`froehlich_kennelly`, Fig. 1.6; `preisach`, Fig. 1.5): the [field] table, its `info` lines,
-// and the outputs. Keys and columns are documented in docs/run-files-chapter1.md.
+// and the outputs. Keys and columns are documented in docs/run-files.md (Chapter 1 section).
 
 #include <filesystem>
 
