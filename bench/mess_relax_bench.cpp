@@ -13,9 +13,10 @@
 #include <string>
 
 #include "mresim/core/constants.hpp"
-#include "mresim/lattice/lattice.hpp"
-#include "mresim/mess/leapfrog.hpp"
-#include "mresim/mess/minimiser.hpp"
+#include "mresim/mess/lattice/lattice.hpp"
+#include "mresim/mess/profile/model_profile.hpp"
+#include "mresim/mess/solvers/leapfrog.hpp"
+#include "mresim/mess/solvers/minimiser.hpp"
 
 namespace {
 
@@ -27,12 +28,12 @@ const char* kMethodNames[] = {"lbfgs", "fire", "leapfrog"};
 
 struct Problem {
   const char* name;
-  lat::Profile profile;
+  const mess::ModelProfile& profile;
   int discretization_order;
   std::array<int, 3> cells;
   std::vector<std::array<int, 3>> centres;  // centre cells
   Eigen::Vector3d field_tesla;
-  double time_step;  // leapfrog, t_c (n_d = 2 needs < 5e-3, reference-notes section 11)
+  double time_step;  // leapfrog, t_c (n_d = 2 needs < 5e-3, docs/original-code.md#time-integration)
 };
 
 // Two particles on the z axis of a mirror-symmetric box, all faces held (the hysteresis
@@ -42,21 +43,21 @@ struct Problem {
 // different (mirror-image) states.
 const Problem kProblems[] = {
     {"n_d=2, 12x12x24 nodes, S = 7.2 um, physical, 0.1 T",
-     lat::Profile::physical,
+     mess::model_profile("physical"),
      2,
      {11, 11, 23},
      {{5, 5, 5}, {5, 5, 17}},
      {0.0, 0.0, 0.1},
      4e-3},
     {"n_d=2, same, seed profile",
-     lat::Profile::seed,
+     mess::model_profile("seed"),
      2,
      {11, 11, 23},
      {{5, 5, 5}, {5, 5, 17}},
      {0.0, 0.0, 0.1},
      4e-3},
     {"n_d=3, 14x14x29 nodes, S = 6.4 um, physical, 50 mT",
-     lat::Profile::physical,
+     mess::model_profile("physical"),
      3,
      {13, 13, 28},
      {{6, 6, 6}, {6, 6, 21}},
@@ -66,7 +67,7 @@ const Problem kProblems[] = {
 
 mess::MessSystem make_system(const Problem& p) {
   lat::LatticeSpec spec;
-  spec.profile = p.profile;
+  p.profile.apply_to(spec);
   spec.discretization_order = p.discretization_order;
   const double l_e = lat::element_length(spec.particle_radius, p.discretization_order);
   lat::ByHandPlacement placement;
@@ -76,7 +77,7 @@ mess::MessSystem make_system(const Problem& p) {
   }
   spec.placement = placement;
   mess::MessSystem sys =
-      mess::MessSystem::make(lat::build_lattice(spec), p.field_tesla / mresim::kMu0);
+      mess::MessSystem::make(lat::build_lattice(spec), p.field_tesla / mresim::kMu0, p.profile);
   const lat::Lattice& l = sys.lattice();
   mess::BoundaryConstraints c = mess::BoundaryConstraints::none(l.node_count());
   for (const lat::Face f : {lat::Face::left, lat::Face::right, lat::Face::front, lat::Face::back,
@@ -98,7 +99,7 @@ Outcome relax(const Problem& p, Method method) {
   mess::MessSystem sys = make_system(p);
   Outcome o;
   if (method == leapfrog) {
-    mess::LeapfrogOptions opt = mess::LeapfrogOptions::for_profile(p.profile);
+    mess::LeapfrogOptions opt = p.profile.leapfrog_options();
     opt.time_step = p.time_step;
     const mess::LeapfrogResult r = mess::relax_leapfrog(sys, opt);
     o.converged = r.converged;
@@ -163,7 +164,7 @@ class RatioReporter : public benchmark::ConsoleReporter {
     std::printf(
         "  (differences of ~1e-3 l_e come from the magnetization tolerance: M is solved to "
         "atol 1e-3, rtol 5e-3 in both,\n   and each method ends somewhere in that band; with "
-        "tight M tolerances they agree to 1e-7 l_e, see tests/mess/relaxation_test.cpp)\n");
+        "tight M tolerances they agree to 1e-7 l_e, see tests/mess/solvers/relaxation_test.cpp)\n");
   }
 
  private:

@@ -9,7 +9,7 @@
 #include "cli/exit_status.hpp"
 #include "mresim/io/hdf5_reader.hpp"
 #include "mresim/io/run_directory.hpp"
-#include "mresim/mess_protocol/checkpoint.hpp"
+#include "mresim/mess/outputs/checkpoint.hpp"
 
 namespace mresim::cli {
 

@@ -39,7 +39,8 @@ TEST(YoungsModulusConversion, ChapterTwoCylinder) {
               2.0 * youngs_from_spring_chapter3(9e-3, 1.5e-6, 12e-6), 1e-9);
 }
 
-// design.md: "by eq. 2.10 S0 = 12.2 um clusters only for k below about 1.06e-2 N/m".
+// By eq. 2.10 S0 = 12.2 um clusters only for k below about 1.06e-2 N/m (claim C5 in
+// docs/validation.md, not "k <= 0.1 N/m" as Section 2.6 says).
 TEST(ClusteringThreshold, Equation210) {
   const SphereMaterial iron;
   EXPECT_NEAR(clustering_threshold_stiffness(iron, 12.2e-6), 1.06e-2, 0.01e-2);

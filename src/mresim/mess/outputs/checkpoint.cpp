@@ -1,0 +1,105 @@
+#include "mresim/mess/outputs/checkpoint.hpp"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+#include "mresim/io/hdf5_file.hpp"
+#include "mresim/io/hdf5_reader.hpp"
+#include "mresim/mess/outputs/step_records_io.hpp"
+#include "mresim/mess/protocols/step_plan.hpp"
+
+namespace mresim::mess_protocol {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::int64_t kFormatVersion = 1;
+
+void write_optional(io::Hdf5File& file, const std::string& path, const Eigen::Matrix3Xd& m,
+                    std::string_view unit) {
+  if (m.cols() > 0) write_columns(file, path, m, unit);
+}
+
+Eigen::Matrix3Xd read_optional(const io::Hdf5Reader& file, const std::string& path,
+                               Eigen::Index expected_columns) {
+  if (!file.exists(path)) return {};
+  Eigen::Matrix3Xd m = read_columns(file, path);
+  if (m.cols() != expected_columns) {
+    throw std::runtime_error(
+        fmt::format("checkpoint: {} has {} rows, expected {}", path, m.cols(), expected_columns));
+  }
+  return m;
+}
+
+}  // namespace
+
+void write_checkpoint(const fs::path& file, const ProtocolState& state,
+                      const ProtocolRunner& runner, std::string_view input_toml,
+                      std::string_view input_name) {
+  const fs::path temporary = fs::path(file.string() + ".tmp");
+  {
+    io::Hdf5File out(temporary);
+    out.write_int_attribute("/", "format_version", kFormatVersion);
+    out.write_string_attribute("/", "input_toml", input_toml);
+    out.write_string_attribute("/", "input_file", input_name);
+    out.write_int_attribute("/", "next_step", static_cast<std::int64_t>(state.next_step));
+    out.write_int_attribute("/", "slots", static_cast<std::int64_t>(state.slots.size()));
+    out.write_int_attribute("/", "references", static_cast<std::int64_t>(state.references.size()));
+    for (std::size_t i = 0; i < state.slots.size(); ++i) {
+      write_optional(out, fmt::format("/slots/{}/positions", i), state.slots[i].positions, "m");
+      write_optional(out, fmt::format("/slots/{}/magnetization", i), state.slots[i].magnetization,
+                     "A/m");
+    }
+    for (std::size_t i = 0; i < state.references.size(); ++i) {
+      write_optional(out, fmt::format("/references/{}", i), state.references[i], "m");
+    }
+    if (!state.records.empty()) {
+      write_step_records(out, "/records", state.records, runner.system().particle_count(),
+                         load_unit(runner.spec()));
+    }
+    out.close();
+  }
+  fs::rename(temporary, file);
+}
+
+ProtocolState read_checkpoint(const fs::path& file, const ProtocolRunner& runner,
+                              std::string_view input_toml) {
+  const io::Hdf5Reader in(file);
+  if (in.int_attribute("/", "format_version") != kFormatVersion) {
+    throw std::runtime_error("checkpoint " + file.string() + ": unknown format version");
+  }
+  if (in.string_attribute("/", "input_toml") != input_toml) {
+    throw std::runtime_error("checkpoint " + file.string() +
+                             " was written for a different run file");
+  }
+  ProtocolState state = runner.initial_state();
+  const auto next = static_cast<std::size_t>(in.int_attribute("/", "next_step"));
+  if (next > runner.steps().size() ||
+      static_cast<std::size_t>(in.int_attribute("/", "slots")) != state.slots.size() ||
+      static_cast<std::size_t>(in.int_attribute("/", "references")) != state.references.size()) {
+    throw std::runtime_error("checkpoint " + file.string() + " does not match the run's steps");
+  }
+  const Eigen::Index nodes = runner.system().node_count();
+  const auto particles = static_cast<Eigen::Index>(runner.system().particle_count());
+  for (std::size_t i = 0; i < state.slots.size(); ++i) {
+    state.slots[i].positions = read_optional(in, fmt::format("/slots/{}/positions", i), nodes);
+    state.slots[i].magnetization =
+        read_optional(in, fmt::format("/slots/{}/magnetization", i), particles);
+  }
+  for (std::size_t i = 0; i < state.references.size(); ++i) {
+    state.references[i] = read_optional(in, fmt::format("/references/{}", i), nodes);
+  }
+  if (next > 0) {
+    state.records =
+        read_step_records(in, "/records", runner.steps(), runner.system().particle_count());
+  }
+  if (state.records.size() != next) {
+    throw std::runtime_error("checkpoint " + file.string() + ": records do not match next_step");
+  }
+  state.next_step = next;
+  return state;
+}
+
+}  // namespace mresim::mess_protocol

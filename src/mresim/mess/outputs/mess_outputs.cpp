@@ -1,0 +1,411 @@
+#include "mresim/mess/outputs/mess_outputs.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+
+#include "mresim/io/csv_writer.hpp"
+#include "mresim/mess/analysis/clusters.hpp"
+#include "mresim/mess/analysis/modulus_fit.hpp"
+#include "mresim/mess/outputs/step_records_io.hpp"
+#include "mresim/mess/protocols/step_plan.hpp"
+
+namespace mresim::mess_protocol {
+
+namespace fs = std::filesystem;
+namespace mc = mresim::mess_config;
+namespace ma = mresim::mess_analysis;
+
+fs::path step_positions_file(const fs::path& run_dir, std::size_t step) {
+  return run_dir / "positions" / fmt::format("step_{:06d}.h5", step);
+}
+
+void write_step_positions(const fs::path& run_dir, std::size_t step,
+                          const Eigen::Matrix3Xd& positions) {
+  const fs::path file = step_positions_file(run_dir, step);
+  fs::create_directories(file.parent_path());
+  const fs::path temporary = fs::path(file.string() + ".tmp");
+  {
+    io::Hdf5File out(temporary);
+    write_columns(out, "/positions", positions, "m");
+    out.close();
+  }
+  fs::rename(temporary, file);
+}
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// VTK/XDMF hexahedron vertex order from the lattice's local order (vertex v at offset
+// ((v>>1)&1, (v>>2)&1, v&1), volume_elements.hpp): (000, 100, 110, 010, 001, 101, 111, 011).
+constexpr std::array<int, 8> kVtkOrder = {0, 2, 6, 4, 1, 3, 7, 5};
+
+void write_lattice(io::Hdf5File& results, const ProtocolRunner& runner) {
+  const lattice::Lattice& lat = runner.system().lattice();
+  results.write_number_attribute("/lattice", "element_length", lat.element_length);
+  results.write_number_attribute("/lattice", "particle_radius", lat.particle_radius);
+  results.write_string_attribute("/lattice", "profile", std::string(runner.spec().profile->name));
+  results.write_int_attribute("/lattice", "node_count", lat.node_count());
+  results.write_int_attribute("/lattice", "cell_count", lat.cell_count());
+  results.write_int_vector("/lattice/shape",
+                           {lat.shape.nodes[0], lat.shape.nodes[1], lat.shape.nodes[2]});
+  const Eigen::Vector3d box = lat.box_lengths();
+  results.write_vector("/lattice/box_lengths", {box.x(), box.y(), box.z()}, "m");
+  Eigen::Matrix3Xd centres(3, static_cast<Eigen::Index>(lat.particle_count()));
+  for (std::size_t p = 0; p < lat.particle_count(); ++p) {
+    centres.col(static_cast<Eigen::Index>(p)) = lat.particle_centres[p];
+  }
+  write_columns(results, "/lattice/initial_centres", centres, "m");
+  results.write_number_attribute("/lattice", "volume_fraction", lat.volume_fraction());
+  if (!runner.spec().output.node_positions) return;
+  write_columns(results, "/lattice/initial_positions", lat.positions, "m");
+  std::vector<std::int64_t> cells;
+  cells.reserve(lat.elements.size() * 8);
+  for (const auto& e : lat.elements) {
+    for (const int v : kVtkOrder) cells.push_back(e[static_cast<std::size_t>(v)]);
+  }
+  results.write_int_array("/lattice/cells", {lat.elements.size(), 8}, cells);
+  std::vector<std::int64_t> particle_id(lat.particle_of_node.begin(), lat.particle_of_node.end());
+  results.write_int_vector("/lattice/particle_id", particle_id);
+}
+
+struct StepExtras {
+  std::vector<double> field_projection;
+  std::vector<double> magnetization_projection;
+  std::vector<double> energy_density;
+  std::vector<double> separation;
+  std::vector<std::int64_t> cluster_count;
+  std::vector<std::int64_t> largest_cluster;
+  std::vector<std::int64_t> cluster_id;  // steps x particles
+};
+
+StepExtras step_extras(const ProtocolRunner& runner, const std::vector<StepRecord>& records) {
+  const Eigen::Vector3d d = field_direction(runner.spec());
+  const double ms = runner.spec().particles.Ms;
+  const double contact = runner.system().model().wca.r_cut() > 0.0
+                             ? runner.system().model().wca.r_cut()
+                             : 2.0 * runner.system().lattice().particle_radius;
+  StepExtras x;
+  for (const StepRecord& r : records) {
+    x.field_projection.push_back(r.step.field.dot(d));
+    const auto np = r.magnetization.cols();
+    x.magnetization_projection.push_back(np > 0 ? (d.transpose() * r.magnetization).mean() / ms
+                                                : 0.0);
+    x.energy_density.push_back(r.energies.total() / r.system_volume);
+    if (!r.centres.allFinite()) {  // no distances: NaN separation, cluster data -1
+      x.separation.push_back(kNaN);
+      x.cluster_count.push_back(-1);
+      x.largest_cluster.push_back(-1);
+      x.cluster_id.insert(x.cluster_id.end(), static_cast<std::size_t>(np), -1);
+      continue;
+    }
+    x.separation.push_back(ma::min_separation(r.centres));
+    const ma::Clusters c = ma::find_clusters(r.centres, contact);
+    x.cluster_count.push_back(c.count);
+    x.largest_cluster.push_back(c.largest);
+    x.cluster_id.insert(x.cluster_id.end(), c.id.begin(), c.id.end());
+  }
+  return x;
+}
+
+std::string modulus_name(const mc::MessSpec& spec) {
+  const mc::LoadKind kind = spec.strain ? spec.strain->kind : spec.stress->kind;
+  if (kind == mc::LoadKind::shear) return "G_eff";
+  if (kind == mc::LoadKind::torsion) return "torsion_stiffness";
+  return "E_eff";
+}
+
+// The modulus of every field (Section 4.2.8) with what the outputs say about its fit.
+struct FieldFits {
+  std::vector<double> magnitude;  // T
+  std::vector<double> modulus;    // Pa (J/m^3 torsion); NaN where underdetermined
+  std::vector<double> offset;     // J/m^3
+  std::vector<double> rms;        // J/m^3 or Pa
+  std::vector<double> mr;         // %
+  std::vector<std::int64_t> first;
+  std::vector<std::int64_t> points;
+  std::vector<std::int64_t> split;
+  std::vector<std::int64_t> valid;
+  std::vector<std::int64_t> mr_valid;  // both this field's and the first field's fit are valid
+  std::vector<std::string> problem;    // "" where valid
+};
+
+FieldFits fit_fields(const mc::MessSpec& spec, const std::vector<StepRecord>& records,
+                     const StepExtras& extras) {
+  FieldFits out;
+  const std::size_t fields = spec.field.values.size();
+  for (std::size_t f = 0; f < fields; ++f) {
+    std::vector<double> strain;
+    std::vector<double> density;
+    std::vector<double> stress;
+    std::vector<bool> converged;
+    for (std::size_t i = 0; i < records.size(); ++i) {
+      if (records[i].step.field_index != f) continue;
+      strain.push_back(records[i].measured_strain);
+      density.push_back(extras.energy_density[i]);
+      stress.push_back(records[i].step.load_value);
+      converged.push_back(records[i].converged);
+    }
+    out.magnitude.push_back(spec.field.values[f].norm());
+    if (spec.strain) {
+      ma::FitOptions options;
+      // The original's zero-point rule is for shear (modulus_fit.hpp).
+      options.drop_zero_point_above_next = spec.strain->kind == mc::LoadKind::shear;
+      options.converged = converged;
+      const ma::QuadraticFit fit = ma::fit_energy_density(strain, density, options);
+      out.modulus.push_back(fit.modulus);
+      out.offset.push_back(fit.offset);
+      out.rms.push_back(fit.rms_residual);
+      out.first.push_back(static_cast<std::int64_t>(fit.first));
+      out.points.push_back(static_cast<std::int64_t>(fit.points));
+      out.split.push_back(fit.split ? 1 : 0);
+      out.valid.push_back(fit.valid ? 1 : 0);
+      out.problem.push_back(fit.problem);
+    } else {
+      const ma::LinearFit fit = ma::fit_stress_strain(strain, stress, converged);
+      out.modulus.push_back(fit.modulus);
+      out.offset.push_back(0.0);
+      out.rms.push_back(fit.rms_residual);
+      out.first.push_back(0);
+      out.points.push_back(static_cast<std::int64_t>(fit.points));
+      out.split.push_back(0);
+      out.valid.push_back(fit.valid ? 1 : 0);
+      out.problem.push_back(fit.problem);
+    }
+  }
+  for (std::size_t f = 0; f < fields; ++f) {
+    out.mr.push_back(ma::mr_effect_percent(out.modulus[f], out.modulus.front()));
+    out.mr_valid.push_back(out.valid[f] != 0 && out.valid.front() != 0 ? 1 : 0);
+  }
+  return out;
+}
+
+// /analysis and modulus.csv, one entry per field; invalid fits go to check.invalid_fits.
+void write_analysis(const fs::path& run_dir, io::Hdf5File& results, const ProtocolRunner& runner,
+                    const std::vector<StepRecord>& records, const StepExtras& extras,
+                    MessResultCheck& check) {
+  const mc::MessSpec& spec = runner.spec();
+  const FieldFits fits = fit_fields(spec, records, extras);
+  const std::string name = modulus_name(spec);
+  for (std::size_t f = 0; f < fits.valid.size(); ++f) {
+    if (fits.valid[f] != 0) continue;
+    check.invalid_fits.push_back(fmt::format("{} at |B| = {:.4g} T (field {}): {}", name,
+                                             fits.magnitude[f], f, fits.problem[f]));
+  }
+
+  const char* unit = name == "torsion_stiffness" ? "J/m^3" : "Pa";
+  results.write_string_attribute("/analysis", "modulus_name", name);
+  results.write_string_attribute("/analysis", "method",
+                                 spec.strain ? "energy density = a x^2/2 + c, least squares"
+                                             : "stress = a x, least squares through 0");
+  results.write_vector("/analysis/field_magnitude", fits.magnitude, "T");
+  results.write_vector("/analysis/modulus", fits.modulus, unit);
+  results.write_vector("/analysis/offset", fits.offset, "J/m^3");
+  results.write_vector("/analysis/rms_residual", fits.rms, spec.strain ? "J/m^3" : "Pa");
+  results.write_int_vector("/analysis/first_point", fits.first);
+  results.write_int_vector("/analysis/fit_points", fits.points);
+  results.write_int_vector("/analysis/split", fits.split);
+  results.write_int_vector("/analysis/valid", fits.valid);
+  results.write_string_vector("/analysis/problem", fits.problem);
+  results.write_vector("/analysis/mr_effect", fits.mr, "%");
+  results.write_int_vector("/analysis/mr_effect_valid", fits.mr_valid);
+
+  io::CsvWriter csv(
+      run_dir / "modulus.csv",
+      {"field_index", "B_T", name + (name == "torsion_stiffness" ? "_J_m3" : "_Pa"), "offset_J_m3",
+       "residual", "first_point", "points", "valid", "mr_effect_percent", "mr_effect_valid"});
+  for (std::size_t f = 0; f < fits.magnitude.size(); ++f) {
+    csv.row({static_cast<double>(f), fits.magnitude[f], fits.modulus[f], fits.offset[f],
+             fits.rms[f], static_cast<double>(fits.first[f]), static_cast<double>(fits.points[f]),
+             static_cast<double>(fits.valid[f]), fits.mr[f],
+             static_cast<double>(fits.mr_valid[f])});
+  }
+}
+
+void write_summary(const fs::path& run_dir, const std::vector<StepRecord>& records,
+                   const StepExtras& x, const std::vector<std::int64_t>& valid,
+                   const char* load_unit) {
+  std::vector<std::string> columns = {
+      "step",           "field_index", "load_index", "Bx_T",
+      "By_T",           "Bz_T",        "B_along_T",  std::string("load_") + load_unit,
+      "measured_strain"};
+  for (const EnergyTerm& t : energy_terms()) columns.push_back(std::string("E_") + t.name + "_J");
+  for (const char* c :
+       {"E_total_J", "energy_density_J_m3", "system_volume_m3", "M_along_Ms", "min_separation_m",
+        "clusters", "converged", "valid", "iterations", "max_force_N", "wall_time_s"}) {
+    columns.emplace_back(c);
+  }
+  io::CsvWriter csv(run_dir / "summary.csv", columns);
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    const StepRecord& r = records[i];
+    std::vector<double> row = {static_cast<double>(r.step.index),
+                               static_cast<double>(r.step.field_index),
+                               static_cast<double>(r.step.load_index),
+                               r.step.field.x(),
+                               r.step.field.y(),
+                               r.step.field.z(),
+                               x.field_projection[i],
+                               r.step.load_value,
+                               r.measured_strain};
+    for (const EnergyTerm& t : energy_terms()) row.push_back(r.energies.*(t.member));
+    row.insert(row.end(), {r.energies.total(), x.energy_density[i], r.system_volume,
+                           x.magnetization_projection[i], x.separation[i],
+                           static_cast<double>(x.cluster_count[i]), r.converged ? 1.0 : 0.0,
+                           static_cast<double>(valid[i]), static_cast<double>(r.iterations),
+                           r.max_force, r.wall_time});
+    csv.row(row);
+  }
+}
+
+// ParaView reads the deformed lattice of every step through this XDMF 3 file.
+void write_xdmf(const fs::path& run_dir, const ProtocolRunner& runner,
+                const std::vector<StepRecord>& records) {
+  const lattice::Lattice& lat = runner.system().lattice();
+  const auto nodes = lat.node_count();
+  const auto cells = lat.cell_count();
+  std::ofstream out(run_dir / "mess.xdmf");
+  out << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n"
+      << "  <Grid Name=\"steps\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  for (const StepRecord& r : records) {
+    const std::size_t s = r.step.index;
+    out << fmt::format("   <Grid Name=\"step_{}\" GridType=\"Uniform\">\n", s)
+        << fmt::format("    <Time Value=\"{}\"/>\n", s)
+        << fmt::format("    <Topology TopologyType=\"Hexahedron\" NumberOfElements=\"{}\">\n",
+                       cells)
+        << fmt::format(
+               "     <DataItem Dimensions=\"{} 8\" NumberType=\"Int\" Precision=\"8\" "
+               "Format=\"HDF\">results.h5:/lattice/cells</DataItem>\n",
+               cells)
+        << "    </Topology>\n    <Geometry GeometryType=\"XYZ\">\n"
+        << fmt::format(
+               "     <DataItem Dimensions=\"{} 3\" NumberType=\"Float\" Precision=\"8\" "
+               "Format=\"HDF\">positions/step_{:06d}.h5:/positions</DataItem>\n",
+               nodes, s)
+        << "    </Geometry>\n"
+        << "    <Attribute Name=\"particle_id\" AttributeType=\"Scalar\" Center=\"Node\">\n"
+        << fmt::format(
+               "     <DataItem Dimensions=\"{}\" NumberType=\"Int\" Precision=\"8\" "
+               "Format=\"HDF\">results.h5:/lattice/particle_id</DataItem>\n",
+               nodes)
+        << "    </Attribute>\n   </Grid>\n";
+  }
+  out << "  </Grid>\n </Domain>\n</Xdmf>\n";
+  if (!out) throw std::runtime_error("cannot write " + (run_dir / "mess.xdmf").string());
+}
+
+}  // namespace
+
+std::string MessResultCheck::message() const {
+  std::string out;
+  if (non_finite.any()) out = non_finite.message("written as NaN; see /steps/valid in results.h5");
+  if (unconverged.any()) {
+    if (!out.empty()) out += "; ";
+    out += unconverged.message("see /steps/solver/converged and /steps/valid in results.h5");
+  }
+  return out;
+}
+
+namespace {
+
+// "step 3 (B = 0.04 T, load 0.02 rad)" (the load only for strain and stress runs).
+std::string step_place(const mc::MessSpec& spec, const StepRecord& r) {
+  const double b = r.step.field.dot(field_direction(spec));
+  if (!spec.strain && !spec.stress) return fmt::format("step {} (B = {:.4g} T)", r.step.index, b);
+  return fmt::format("step {} (B = {:.4g} T, load {:.4g} {})", r.step.index, b, r.step.load_value,
+                     load_unit(spec));
+}
+
+// The non-finite quantities of a step, comma-separated ("" when all are finite).
+std::string non_finite_quantities(const StepRecord& r) {
+  std::vector<std::string> bad;
+  bool energy = std::isfinite(r.energies.total());
+  for (const EnergyTerm& t : energy_terms())
+    energy = energy && std::isfinite(r.energies.*(t.member));
+  if (!energy) bad.emplace_back("energy");
+  if (!std::isfinite(r.system_volume)) bad.emplace_back("system volume");
+  if (!std::isfinite(r.measured_strain)) bad.emplace_back("measured strain");
+  if (!r.centres.allFinite()) bad.emplace_back("particle centres");
+  if (!r.magnetization.allFinite()) bad.emplace_back("magnetization");
+  if (!std::isfinite(r.max_force)) bad.emplace_back("max force");
+  if (!std::isfinite(r.magnetization_residual)) bad.emplace_back("magnetization residual");
+  std::string out;
+  for (const std::string& b : bad) out += (out.empty() ? "" : ", ") + b;
+  return out;
+}
+
+void nan_if_not_finite(double& v) {
+  if (!std::isfinite(v)) v = kNaN;
+}
+
+}  // namespace
+
+std::vector<std::int64_t> check_steps(const mc::MessSpec& spec,
+                                      const std::vector<StepRecord>& records,
+                                      MessResultCheck& check) {
+  std::vector<std::int64_t> valid;
+  valid.reserve(records.size());
+  for (const StepRecord& r : records) {
+    const std::string bad = non_finite_quantities(r);
+    if (!bad.empty()) {
+      check.non_finite.flag(bad, step_place(spec, r));
+    } else if (!r.converged) {
+      // converged relaxation, unconverged final magnetization solve (protocol_runner.cpp)
+      const std::string what =
+          r.status == "converged"
+              ? fmt::format("final magnetization solve ({}, residual {:.3g} Ms)",
+                            r.magnetization_method, r.magnetization_residual)
+              : fmt::format("relaxation ({})", r.status);
+      check.unconverged.flag(what, step_place(spec, r));
+    }
+    valid.push_back(bad.empty() && r.converged ? 1 : 0);
+  }
+  return valid;
+}
+
+std::vector<StepRecord> with_nan_for_non_finite(std::vector<StepRecord> records) {
+  for (StepRecord& r : records) {
+    for (const EnergyTerm& t : energy_terms()) nan_if_not_finite(r.energies.*(t.member));
+    nan_if_not_finite(r.system_volume);
+    nan_if_not_finite(r.measured_strain);
+    nan_if_not_finite(r.max_force);
+    nan_if_not_finite(r.magnetization_residual);
+    for (Eigen::Matrix3Xd* m : {&r.centres, &r.magnetization}) {
+      *m = m->unaryExpr([](double v) { return std::isfinite(v) ? v : kNaN; });
+    }
+  }
+  return records;
+}
+
+MessResultCheck write_mess_results(const fs::path& run_dir, io::Hdf5File& results,
+                                   const ProtocolRunner& runner,
+                                   const std::vector<StepRecord>& computed) {
+  const mc::MessSpec& spec = runner.spec();
+  const char* unit = load_unit(spec);
+  MessResultCheck check;
+  const std::vector<std::int64_t> valid = check_steps(spec, computed, check);
+  const std::vector<StepRecord> records = with_nan_for_non_finite(computed);
+  write_lattice(results, runner);
+  const std::size_t np = runner.system().particle_count();
+  write_step_records(results, "/steps", records, np, unit);
+  results.write_int_vector("/steps/valid", valid);
+  const StepExtras x = step_extras(runner, records);
+  const Eigen::Vector3d d = field_direction(spec);
+  results.write_vector("/steps/field_direction", {d.x(), d.y(), d.z()}, "1");
+  results.write_vector("/steps/field_projection", x.field_projection, "T");
+  results.write_vector("/steps/magnetization_projection", x.magnetization_projection, "1");
+  results.write_vector("/steps/energy_density", x.energy_density, "J/m^3");
+  results.write_vector("/steps/separation", x.separation, "m");
+  results.write_int_vector("/steps/cluster_count", x.cluster_count);
+  results.write_int_vector("/steps/largest_cluster", x.largest_cluster);
+  results.write_int_array("/steps/cluster_id", {records.size(), np}, x.cluster_id);
+  write_summary(run_dir, records, x, valid, unit);
+  if (spec.strain || spec.stress) write_analysis(run_dir, results, runner, records, x, check);
+  if (spec.output.node_positions) write_xdmf(run_dir, runner, records);
+  return check;
+}
+
+}  // namespace mresim::mess_protocol

@@ -1,0 +1,189 @@
+#include "mresim/mess/protocols/protocol_runner.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include "mresim/core/constants.hpp"
+#include "mresim/mess/lattice/volume_elements.hpp"
+#include "mresim/mess/protocols/loading.hpp"
+#include "mresim/mess/solvers/leapfrog.hpp"
+#include "mresim/mess/solvers/minimiser.hpp"
+
+namespace mresim::mess_protocol {
+
+namespace mc = mresim::mess_config;
+namespace mm = mresim::magnetism;
+
+namespace {
+
+mess::MessSystem make_system(const mc::MessSpec& spec) {
+  lattice::Lattice lat = lattice::build_lattice(spec.lattice);
+  mm::MagneticParticles particles = spec.particles;
+  particles.radius = lat.particle_radius;
+  mm::MagneticModel model = mm::MagneticModel::make(particles, Eigen::Vector3d::Zero(),
+                                                    spec.profile->wca_scale_ms(particles.Ms));
+  model.demagnetization = spec.demagnetization;
+  model.self_energy = spec.self_energy;
+  mess::MessSettings settings = spec.profile->system_settings();
+  settings.magnetization = spec.solver.magnetization;
+  settings.magnetization.demagnetization = spec.demagnetization;
+  return {std::move(lat), std::move(model), settings};
+}
+
+// The load of one step; `reference` as loading.hpp describes.
+LoadState load_of(const mc::MessSpec& spec, const lattice::Lattice& lat, const StepSpec& step,
+                  const Eigen::Matrix3Xd& reference) {
+  switch (spec.run_type) {
+    case mc::MessRunType::hysteresis:
+      return hysteresis_load(lat, reference);
+    case mc::MessRunType::magnetostriction:
+      return magnetostriction_load(lat, reference);
+    case mc::MessRunType::strain:
+      return strain_load(lat, *spec.strain, step.load_value, reference);
+    case mc::MessRunType::stress:
+      return stress_load(lat, *spec.stress, step.load_value, reference);
+  }
+  throw std::logic_error("mess_protocol: unknown run type");
+}
+
+// The strain axis of the modulus fit for strain runs: tan(gamma) for shear (the engineering
+// shear strain of the affine field u = h tan(gamma), for which linear elasticity gives the
+// energy density G tan^2(gamma)/2), the engineering strain, the twist angle.
+double applied_strain(const mc::StrainSpec& strain, double value) {
+  return strain.kind == mc::LoadKind::shear ? std::tan(value) : value;
+}
+
+}  // namespace
+
+double system_volume(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x) {
+  double volume = 0.0;
+  lattice::CellVertices v;
+  for (const auto& e : lat.elements) {
+    for (int k = 0; k < 8; ++k)
+      v[static_cast<std::size_t>(k)] = x.col(e[static_cast<std::size_t>(k)]);
+    volume += lattice::cell_volume(v);
+  }
+  return volume;
+}
+
+ProtocolRunner::ProtocolRunner(const mc::MessSpec& spec)
+    : spec_(spec), steps_(plan_steps(spec)), system_(make_system(spec)) {}
+
+std::size_t ProtocolRunner::slot_of_field(std::size_t field_index) const {
+  return spec_.load_step_count() > 1 ? field_index : 0;
+}
+
+ProtocolState ProtocolRunner::initial_state() const {
+  ProtocolState state;
+  const std::size_t fields = spec_.field.values.size();
+  state.slots.resize(spec_.load_step_count() > 1 ? fields : 1);
+  state.references.resize(spec_.load_step_count() > 1 ? fields : 0);
+  return state;
+}
+
+const SlotState* ProtocolRunner::start_state(const StepSpec& step,
+                                             const ProtocolState& state) const {
+  if (step.load_index > 0) return &state.slots[slot_of_field(step.field_index)];
+  if (step.field_index == 0) return nullptr;  // the initial lattice
+  return &state.slots[slot_of_field(step.field_index - 1)];
+}
+
+const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
+  if (state.next_step >= steps_.size()) {
+    throw std::logic_error("ProtocolRunner::run_next_step: no steps left");
+  }
+  const auto started = std::chrono::steady_clock::now();
+  const StepSpec& step = steps_[state.next_step];
+  const lattice::Lattice& lat = system_.lattice();
+
+  // Boundary conditions: loaded steps are measured from the zero-load state at this field.
+  const bool loaded = step.load_index > 0 && spec_.run_type == mc::MessRunType::strain;
+  const Eigen::Matrix3Xd& reference = loaded ? state.references[step.field_index] : lat.positions;
+  LoadState load = load_of(spec_, lat, step, reference);
+
+  const SlotState* start = start_state(step, state);
+  system_.set_constraints(std::move(load.constraints));
+  system_.set_applied_forces(load.applied_forces);
+  system_.set_positions(start != nullptr && start->positions.cols() > 0 ? start->positions
+                                                                        : lat.positions);
+  if (start != nullptr && start->magnetization.cols() > 0) {
+    system_.set_magnetizations(start->magnetization);
+  }
+  system_.set_applied_field(step.field / kMu0);
+
+  const mess::MagnetizationStats before = system_.magnetization_stats();
+  StepRecord record;
+  record.step = step;
+  const double b = step.field.norm();
+  if (spec_.solver.method == mc::SolverMethod::minimiser) {
+    mess::MinimiserOptions options;
+    options.force_tolerance = spec_.solver.minimiser.force_tolerance;
+    options.max_iterations = static_cast<int>(spec_.solver.minimiser.max_iterations);
+    const mess::MinimiserResult r = mess::minimise(system_, options);
+    record.converged = r.converged;
+    record.status = to_string(r.status);
+    record.iterations = r.iterations;
+    record.evaluations = r.evaluations;
+    record.max_force = r.max_force;
+    record.energies = r.final.energies;
+  } else {
+    mess::LeapfrogOptions options = spec_.profile->leapfrog_options();
+    options.time_step = spec_.solver.leapfrog.dt;
+    options.steps_per_round = static_cast<int>(spec_.solver.leapfrog.steps_per_round);
+    options.max_rounds = static_cast<int>(spec_.solver.leapfrog.max_rounds);
+    options.drag = spec_.solver.leapfrog.drag;
+    // docs/original-code.md#convergence: at zero field and zero load one round may end the step.
+    options.first_round_may_end = b < 1e-12 && step.load_value == 0.0;
+    const mess::LeapfrogResult r = mess::relax_leapfrog(system_, options);
+    record.converged = r.converged;
+    record.status = to_string(r.status);
+    record.iterations = r.steps;
+    record.evaluations = r.steps + 1;
+    record.max_force = r.history.empty() ? 0.0 : r.history.back().mean_abs_acceleration;
+    record.energies = r.final.energies;
+  }
+
+  const mess::MagnetizationStats& after = system_.magnetization_stats();
+  record.magnetization_solves = after.solves - before.solves;
+  record.unconverged_magnetization_solves = after.unconverged - before.unconverged;
+  record.magnetization_method = mm::to_string(after.last.method);
+  record.magnetization_iterations = after.last.total_iterations;
+  record.magnetization_residual = after.last.residual;
+  record.converged = record.converged && (system_.particle_count() == 0 || after.last.converged);
+
+  record.centres = system_.particle_centres();
+  record.magnetization = system_.magnetizations();
+  record.system_volume = system_volume(lat, system_.positions());
+  if (spec_.strain) {
+    record.measured_strain = applied_strain(*spec_.strain, step.load_value);
+  } else if (spec_.stress) {
+    const Eigen::Matrix3Xd& zero_stress =
+        step.load_index > 0 ? state.references[step.field_index] : system_.positions();
+    record.measured_strain = measured_strain(lat, *spec_.stress, system_.positions(), zero_stress);
+  }
+
+  // Advance the state.
+  SlotState& slot = state.slots[slot_of_field(step.field_index)];
+  slot.positions = system_.positions();
+  slot.magnetization = system_.magnetizations();
+  if (step.load_index == 0 && !state.references.empty()) {
+    state.references[step.field_index] = system_.positions();
+  }
+  record.wall_time =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  state.records.push_back(std::move(record));
+  ++state.next_step;
+  return state.records.back();
+}
+
+void ProtocolRunner::run(ProtocolState& state,
+                         const std::function<void(const ProtocolState&)>& after_step) {
+  while (state.next_step < steps_.size()) {
+    run_next_step(state);
+    if (after_step) after_step(state);
+  }
+}
+
+}  // namespace mresim::mess_protocol

@@ -1,0 +1,99 @@
+#pragma once
+
+// Runs the steps of a 3D protocol (Section 4.2.7): builds the system from the run file's
+// MessSpec, and for every step sets the field and the boundary conditions, starts from the
+// state Section 4.2.7 and docs/original-code.md#step-order prescribe, relaxes (minimiser or the
+// dissertation's leapfrog) and records what the outputs need.
+//
+// Where a step starts (positions and magnetizations; velocities are zero):
+//  - the first load value (and every step of hysteresis and magnetostriction runs): from the
+//    previous step (the previous field), the first from the initial lattice with no
+//    magnetization history;
+//  - later load values: from the result of the previous load value at the same field (the
+//    original's output n - (F - 1)). Unlike the original this also holds with a single field.
+// The zero-load result at each field is the reference configuration of the loaded steps at that
+// field (strain values are applied relative to it; a stress run's strain is measured from it).
+//
+// The whole evolving state (ProtocolState) is plain data, so a checkpoint (checkpoint.hpp) can
+// save it after any step and a resumed run continues bit for bit as the uninterrupted one.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "mresim/mess/protocols/step_plan.hpp"
+#include "mresim/mess/run_file/mess_spec.hpp"
+#include "mresim/mess/system/system_energy.hpp"
+
+namespace mresim::mess_protocol {
+
+// What one converged (or not) step leaves for the outputs.
+struct StepRecord {
+  StepSpec step;
+  mess::MessEnergies energies;
+  double system_volume = 0.0;      // sum of the cell volumes, m^3
+                                   // (docs/original-code.md#energies-and-moduli)
+  double measured_strain = 0.0;    // strain runs: the applied strain (tan gamma for shear, the
+                                   // engineering strain, the twist angle); stress runs: measured
+  Eigen::Matrix3Xd centres;        // m, 3 x N_p
+  Eigen::Matrix3Xd magnetization;  // A/m, 3 x N_p
+
+  // Solver diagnostics.
+  bool converged = false;        // relaxation converged and the final magnetization solve too
+  std::string status;            // the relaxation method's status
+  std::int64_t iterations = 0;   // minimiser iterations or leapfrog time steps
+  std::int64_t evaluations = 0;  // force evaluations
+  double max_force = 0.0;        // N (minimiser); leapfrog: mean |a| of its last round, scaled
+  std::int64_t magnetization_solves = 0;
+  std::int64_t unconverged_magnetization_solves = 0;
+  std::string magnetization_method;  // of the final solve
+  std::int64_t magnetization_iterations = 0;
+  double magnetization_residual = 0.0;  // of the final solve, units of Ms
+  double wall_time = 0.0;               // s
+};
+
+// The latest converged state at one field (or of the previous step; see above).
+struct SlotState {
+  Eigen::Matrix3Xd positions;      // 0 columns: the initial lattice
+  Eigen::Matrix3Xd magnetization;  // 0 columns: no history
+};
+
+struct ProtocolState {
+  std::size_t next_step = 0;
+  std::vector<SlotState> slots;              // one per field for strain/stress runs, else one
+  std::vector<Eigen::Matrix3Xd> references;  // zero-load result per field (0 columns: unset)
+  std::vector<StepRecord> records;           // of steps 0 .. next_step - 1
+};
+
+class ProtocolRunner {
+ public:
+  // Builds the lattice and the system (may take a few seconds for the largest systems).
+  explicit ProtocolRunner(const mess_config::MessSpec& spec);
+
+  const mess_config::MessSpec& spec() const { return spec_; }
+  const std::vector<StepSpec>& steps() const { return steps_; }
+  const mess::MessSystem& system() const { return system_; }
+
+  ProtocolState initial_state() const;
+
+  // Runs step state.next_step and advances the state. Throws std::logic_error past the end.
+  const StepRecord& run_next_step(ProtocolState& state);
+
+  // Runs the remaining steps; after each one calls after_step(state) (checkpoints, progress).
+  void run(ProtocolState& state, const std::function<void(const ProtocolState&)>& after_step);
+
+ private:
+  std::size_t slot_of_field(std::size_t field_index) const;
+  const SlotState* start_state(const StepSpec& step, const ProtocolState& state) const;
+
+  mess_config::MessSpec spec_;
+  std::vector<StepSpec> steps_;
+  mess::MessSystem system_;
+};
+
+// Sum of the cell volumes (m^3) at positions x.
+double system_volume(const lattice::Lattice& lattice, const Eigen::Matrix3Xd& x);
+
+}  // namespace mresim::mess_protocol

@@ -1,0 +1,357 @@
+// `mresim info` for the 3D run types: everything the run file implies, from closed forms and the
+// placed particles (MessGeometry), without building springs or relaxing anything.
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "mresim/core/constants.hpp"
+#include "mresim/mess/run_file/mess_spec.hpp"
+
+namespace mresim::mess_config {
+
+namespace {
+
+constexpr double kRadian = 180.0 / std::numbers::pi;
+// Centres listed one by one up to this many particles; the closest pair is searched up to
+// kClosestPairLimit particles (O(N^2)).
+constexpr std::size_t kCentresShown = 64;
+constexpr std::size_t kClosestPairLimit = 4000;
+
+const char* axis_name(int a) { return a == 0 ? "x" : a == 1 ? "y" : "z"; }
+
+std::string with_thousands(std::int64_t n) {
+  std::string digits = fmt::format("{}", n < 0 ? -n : n);
+  std::string out;
+  for (std::size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
+    out += digits[i];
+  }
+  return n < 0 ? "-" + out : out;
+}
+
+std::string placement_name(const MessSpec& s) { return lattice::to_string(s.placement_kind); }
+
+void describe_lattice(const MessSpec& s, app::InfoReport& r) {
+  const MessGeometry& g = s.geometry;
+  const std::string sec = "lattice";
+  r.add(sec, "element_length", g.element_length, "m", "l_e = 2R/(2 n_d + 1), eq. 4.49");
+  r.add_text(sec, "grid", fmt::format("{} x {} x {}", g.shape.nx(), g.shape.ny(), g.shape.nz()),
+             "nodes along x, y, z");
+  r.add_integer(sec, "nodes", g.node_count());
+  r.add_integer(sec, "cells", g.cell_count(), "", "volume elements");
+  r.add(sec, "box_length_x", g.box_lengths[0], "m", "(N_x - 1) l_e");
+  r.add(sec, "box_length_y", g.box_lengths[1], "m");
+  r.add(sec, "box_length_z", g.box_lengths[2], "m");
+  r.add(sec, "box_volume", g.box_lengths.prod(), "m^3");
+  if (s.box) {
+    r.add_text(sec, "box_rounding",
+               s.box->rounding == lattice::BoxRounding::nearest ? "nearest" : "seed_floor_divide",
+               s.box->rounding == lattice::BoxRounding::nearest
+                   ? "N = round(L/l_e + 1)"
+                   : "N = (L // l_e) + 1, the original's by-hand rule");
+  }
+  const lattice::SpringCounts& c = g.springs;
+  const ParticleSpringCounts& p = g.particle_springs;
+  r.add_integer(sec, "springs", c.total(), "", "closed forms (docs/lattice.md)");
+  r.add_integer(sec, "edge_springs", c.edge.total(), "",
+                fmt::format("{} at k_e/4, {} at k_e/2, {} with the particle constant",
+                            with_thousands(c.edge.quarter), with_thousands(c.edge.half),
+                            with_thousands(p.edge)));
+  r.add_integer(sec, "face_springs", c.face.total(), "",
+                fmt::format("{} at k_f/2, {} with the particle constant",
+                            with_thousands(c.face.half), with_thousands(p.face)));
+  r.add_integer(sec, "body_springs", c.body.total(), "",
+                fmt::format("{} with the particle constant", with_thousands(p.body)));
+  r.add_integer(sec, "particle_springs", p.total(), "",
+                s.lattice.particle_spring_rule == lattice::ParticleSpringRule::same_particle
+                    ? "both ends in the same particle"
+                    : "both ends particle nodes of any particles (as the original code)");
+}
+
+void describe_stiffness(const MessSpec& s, app::InfoReport& r) {
+  const lattice::LatticeSpec& l = s.lattice;
+  const double l_e = s.geometry.element_length;
+  const std::string sec = "stiffness";
+  const lattice::LatticeStiffness k = lattice::polymer_stiffness(
+      l.shear_modulus_rule, l.youngs_modulus, l.poisson_ratio, l_e, l.stiffness_ratio);
+  const lattice::LatticeModuli m = lattice::lattice_moduli(k, l_e);
+  const bool exact_moduli =
+      l.shear_modulus_rule == lattice::ShearModulusRule::from_youngs_and_poisson;
+  r.add_text(sec, "profile", std::string(s.profile->name),
+             std::string(s.profile->shear_modulus_note));
+  r.add(sec, "youngs_modulus", l.youngs_modulus, "Pa", "polymer E, as given");
+  r.add(sec, "poisson_ratio", l.poisson_ratio, "", "polymer nu, as given");
+  r.add(sec, "stiffness_ratio", l.stiffness_ratio, "", "A = k_f/k_c");
+  r.add(sec, "k_e", k.springs.edge, "N/m", "edge springs, bulk value");
+  r.add(sec, "k_f", k.springs.face, "N/m", "face diagonals, bulk value");
+  r.add(sec, "k_c", k.springs.body, "N/m", "body diagonals");
+  r.add(sec, "kappa", k.kappa, "Pa", "extra bulk modulus, eq. 4.22");
+  r.add(sec, "lattice_shear_modulus", m.shear_modulus, "Pa",
+        exact_moduli ? "= E/(2(1+nu))" : "= 0.4 E (nu-independent, as the original code)");
+  r.add(sec, "lattice_bulk_modulus", m.bulk_modulus, "Pa", "kappa + 5G/3, eq. 4.21");
+  r.add(sec, "lattice_youngs_modulus", m.youngs_modulus, "Pa", "particle-free, uniaxial stress");
+  r.add(sec, "lattice_poisson_ratio", m.poisson_ratio, "", "particle-free, uniaxial stress");
+  const lattice::SpringConstants kp = lattice::particle_spring_constants(
+      l.shear_modulus_rule, l.youngs_modulus, l.poisson_ratio, l_e, l.stiffness_ratio);
+  r.add(sec, "particle_youngs_modulus", lattice::particle_youngs_modulus(l.youngs_modulus), "Pa",
+        "E_p = min(2.11e11 Pa, 1e4 E)");
+  r.add(sec, "particle_k_e", kp.edge, "N/m");
+  r.add(sec, "particle_k_f", kp.face, "N/m");
+  r.add(sec, "particle_k_c", kp.body, "N/m");
+}
+
+void describe_scales(const MessSpec& s, app::InfoReport& r) {
+  const lattice::LatticeSpec& l = s.lattice;
+  const double l_e = s.geometry.element_length;
+  const std::string sec = "scales";
+  const lattice::LatticeStiffness k = lattice::polymer_stiffness(
+      l.shear_modulus_rule, l.youngs_modulus, l.poisson_ratio, l_e, l.stiffness_ratio);
+  const double m_c = l.polymer_density * l_e * l_e * l_e;
+  const double k_eff = lattice::effective_spring_constant(k.springs);
+  const double t_c = 2.0 * std::numbers::pi * std::sqrt(m_c / k_eff);
+  r.add(sec, "length", l_e, "m", "x_c = l_e");
+  r.add(sec, "mass", m_c, "kg", "m_c = rho_polymer l_e^3 (an interior polymer node)");
+  r.add(sec, "k_eff", k_eff, "N/m", "2 k_e + 8 k_f/sqrt(2) + 4 k_c");
+  r.add(sec, "time", t_c, "s", "t_c = 2 pi sqrt(m_c/k_eff)");
+  r.add(sec, "force", k_eff * l_e, "N", "k_eff l_e");
+  const double particle_mass = l.iron_density * lattice::sphere_volume(l.particle_radius);
+  r.add(sec, "particle_mass", particle_mass, "kg", "rho_iron 4/3 pi R^3, eq. 4.53");
+  r.add(sec, "particle_node_mass",
+        particle_mass / static_cast<double>(s.geometry.nodes_per_particle), "kg",
+        fmt::format("{:.3g} m_c",
+                    particle_mass / static_cast<double>(s.geometry.nodes_per_particle) / m_c));
+}
+
+void describe_particles(const MessSpec& s, app::InfoReport& r) {
+  const MessGeometry& g = s.geometry;
+  const std::string sec = "particles";
+  const magnetism::MagneticParticles& p = s.particles;
+  r.add_integer(sec, "count", static_cast<std::int64_t>(g.particle_count()));
+  r.add_text(sec, "placement", placement_name(s));
+  if (s.requested_volume_fraction) {
+    r.add(sec, "requested_volume_fraction", *s.requested_volume_fraction, "");
+  }
+  r.add(sec, "volume_fraction", g.volume_fraction, "",
+        "N V_p / (L_x L_y L_z) of the lattice, eq. 4.50");
+  r.add(sec, "radius", p.radius, "m");
+  r.add(sec, "volume", p.volume(), "m^3", "V_p = 4/3 pi R^3");
+  r.add_integer(sec, "discretization_order", s.lattice.discretization_order, "",
+                fmt::format("n_d: {} voxels across", 2 * s.lattice.discretization_order + 1));
+  r.add_integer(sec, "nodes_per_particle", g.nodes_per_particle);
+  r.add(sec, "saturation_magnetization", p.Ms, "A/m");
+  r.add(sec, "susceptibility", p.chi0, "", "chi0 of the Froehlich-Kennelly law, eq. 4.55");
+  r.add_text(sec, "demagnetization", s.demagnetization ? "on" : "off",
+             s.demagnetization ? "FK law applied to H_local - M/3" : "the dissertation's law");
+  r.add_text(sec, "self_energy",
+             s.self_energy == magnetism::SelfEnergyForm::consistent ? "consistent" : "linearized",
+             s.self_energy == magnetism::SelfEnergyForm::consistent
+                 ? "eq. 4.76, consistent with the dipole forces"
+                 : "eq. 4.73, the dissertation's energy plots");
+  const magnetism::WcaParameters wca =
+      magnetism::WcaParameters::from_radius(p.radius, s.profile->wca_scale_ms(p.Ms));
+  r.add(sec, "wca_energy", wca.e_max, "J",
+        s.profile->wca_ms ? fmt::format("mu0 pi Ms^2 R^3/72 with Ms = {:g} A/m ({} profile)",
+                                        *s.profile->wca_ms, s.profile->name)
+                          : "mu0 pi Ms^2 R^3/72, eq. 4.79");
+  r.add(sec, "wca_r_min", wca.r_min, "m", "2R + 100 nm");
+  if (!s.demagnetization) {
+    r.add(sec, "zero_field_instability_distance", p.radius * std::cbrt(2.0 * p.chi0 / 3.0), "m",
+          "pairs along the field closer than R (2 chi0/3)^(1/3) keep a remanent M at B = 0");
+  }
+  const std::size_t n = g.particle_count();
+  if (n >= 2 && n <= kClosestPairLimit) {
+    double closest = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t j = i + 1; j < n; ++j) {
+        closest = std::min(closest, (g.particle_centres[i] - g.particle_centres[j]).norm());
+      }
+    }
+    r.add(sec, "closest_centre_distance", closest, "m",
+          fmt::format("{:.4g} R; contact at 2R", closest / p.radius));
+  }
+  for (std::size_t i = 0; i < n && i < kCentresShown; ++i) {
+    const Eigen::Vector3d& x = g.particle_centres[i];
+    const auto& c = g.centre_cells[i];
+    r.add_text(sec, fmt::format("centre_{}", i),
+               fmt::format("({:.6g}, {:.6g}, {:.6g}) m", x[0], x[1], x[2]),
+               fmt::format("({}.5, {}.5, {}.5) l_e", c[0], c[1], c[2]));
+  }
+  if (n > kCentresShown) {
+    r.add_text(sec, "centres_not_shown", fmt::format("{}", n - kCentresShown),
+               "only the first 64 centres are listed");
+  }
+}
+
+void describe_field(const MessSpec& s, app::InfoReport& r) {
+  const FieldSpec& f = s.field;
+  const std::string sec = "field";
+  switch (f.form) {
+    case FieldSpec::Form::max_and_steps:
+      r.add_text(sec, "given_as", "max and steps");
+      r.add(sec, "max", f.max, "T", "B_ext = mu0 H_ext");
+      r.add_integer(sec, "increments", f.steps, "",
+                    fmt::format("step {:.6g} T", f.max / static_cast<double>(f.steps)));
+      break;
+    case FieldSpec::Form::magnitudes:
+      r.add_text(sec, "given_as", "magnitudes");
+      r.add(sec, "max", f.max, "T", "B_ext = mu0 H_ext");
+      r.add_integer(sec, "magnitudes", static_cast<std::int64_t>(f.magnitudes.size()));
+      break;
+    case FieldSpec::Form::vectors:
+      r.add_text(sec, "given_as", "vectors");
+      r.add(sec, "max", f.max, "T", "largest |B_ext|");
+      break;
+  }
+  if (f.form != FieldSpec::Form::vectors) {
+    r.add(sec, "theta", f.theta_deg, "deg", "polar angle from +z");
+    r.add(sec, "phi", f.phi_deg, "deg", "azimuth from +x");
+    const Eigen::Vector3d u = field_vector(1.0, f.theta_deg, f.phi_deg);
+    r.add_text(sec, "direction", fmt::format("({:.6g}, {:.6g}, {:.6g})", u[0], u[1], u[2]));
+    r.add_text(
+        sec, "sequence", f.sequence == FieldSequence::loop ? "loop" : "up",
+        f.sequence == FieldSequence::loop ? "0 -> max -> -max -> max" : "the magnitudes in order");
+  }
+  r.add_integer(sec, "fields", static_cast<std::int64_t>(f.values.size()),
+                s.run_type == MessRunType::strain || s.run_type == MessRunType::stress
+                    ? "applied at every load value"
+                    : "relaxations");
+  r.add(sec, "max_reduced_field", f.max / (kMu0 * s.particles.Ms), "", "h = B/(mu0 Ms)");
+}
+
+template <typename Spec>
+void describe_axes(const Spec& spec, const std::string& sec, app::InfoReport& r) {
+  r.add_text(sec, "kind", to_string(spec.kind));
+  r.add_text(sec, "normal", axis_name(spec.normal), "loaded faces are normal to this axis");
+  if (spec.kind == LoadKind::shear) {
+    r.add_text(sec, "direction", axis_name(spec.direction), "displacement or traction axis");
+  }
+}
+
+void describe_loads(const MessSpec& s, app::InfoReport& r) {
+  if (s.strain) {
+    const StrainSpec& st = *s.strain;
+    const std::string sec = "strain";
+    describe_axes(st, sec, r);
+    if (st.kind == LoadKind::shear) {
+      r.add_text(sec, "boundary",
+                 st.boundary == ShearBoundary::all_faces ? "all_faces" : "normal_faces",
+                 st.boundary == ShearBoundary::all_faces
+                     ? "every surface node follows u = h tan(gamma) (eq. 4.96)"
+                     : "faces normal to the normal axis held, side faces free");
+    }
+    const auto [lo, hi] = std::minmax_element(st.values.begin(), st.values.end());
+    const bool angle = st.kind == LoadKind::torsion;
+    const double scale = angle ? kRadian : 1.0;
+    const std::string unit = st.kind == LoadKind::shear ? "rad" : angle ? "deg" : "";
+    r.add(sec, "min", *lo * scale, unit,
+          st.kind == LoadKind::compression ? "compression is negative" : "");
+    r.add(sec, "max", *hi * scale, unit);
+    r.add_integer(sec, "values", static_cast<std::int64_t>(st.values.size()), "",
+                  "including the zero-strain reference");
+  }
+  if (s.stress) {
+    const StressSpec& st = *s.stress;
+    const std::string sec = "stress";
+    describe_axes(st, sec, r);
+    r.add_text(sec, "loading", st.loading == StressLoading::one_face ? "one_face" : "both_faces",
+               st.loading == StressLoading::one_face
+                   ? "lower face fixed, traction on the upper face"
+                   : "opposite tractions on both faces, nothing fixed");
+    const auto [lo, hi] = std::minmax_element(st.values.begin(), st.values.end());
+    r.add(sec, "min", *lo, "Pa", st.kind == LoadKind::compression ? "compression is negative" : "");
+    r.add(sec, "max", *hi, "Pa");
+    const Eigen::Vector3d& L = s.geometry.box_lengths;
+    const int a = (st.normal + 1) % 3;
+    const int b = (st.normal + 2) % 3;
+    r.add(sec, "loaded_face_area", L[a] * L[b], "m^2", "initial area of the loaded face");
+    r.add_integer(sec, "values", static_cast<std::int64_t>(st.values.size()), "",
+                  "including the zero-stress reference");
+  }
+}
+
+void describe_solver(const MessSpec& s, app::InfoReport& r) {
+  const SolverSpec& v = s.solver;
+  const std::string sec = "solver";
+  if (v.method == SolverMethod::minimiser) {
+    r.add_text(sec, "method", "minimiser");
+    r.add(sec, "force_tolerance", v.minimiser.force_tolerance, "k_eff l_e",
+          "largest net force on a free node");
+    r.add_integer(sec, "max_iterations", v.minimiser.max_iterations);
+  } else {
+    const lattice::LatticeSpec& l = s.lattice;
+    const double l_e = s.geometry.element_length;
+    const lattice::LatticeStiffness k = lattice::polymer_stiffness(
+        l.shear_modulus_rule, l.youngs_modulus, l.poisson_ratio, l_e, l.stiffness_ratio);
+    const double k_eff = lattice::effective_spring_constant(k.springs);
+    const double t_c =
+        2.0 * std::numbers::pi * std::sqrt(l.polymer_density * l_e * l_e * l_e / k_eff);
+    r.add_text(sec, "method", "leapfrog", "the seed's damped dynamics (reference)");
+    std::string note = fmt::format("{:.6g} s", v.leapfrog.dt * t_c);
+    if (const auto limit = leapfrog_stability_limit(l.discretization_order)) {
+      note += fmt::format("; seed stability limit about {:.2g} for n_d = {}", *limit,
+                          l.discretization_order);
+      if (v.leapfrog.dt >= *limit) note += " - EXCEEDED, expect blow-up";
+    }
+    r.add(sec, "dt", v.leapfrog.dt, "t_c", note);
+    r.add_integer(sec, "steps_per_round", v.leapfrog.steps_per_round);
+    r.add_integer(sec, "max_rounds", v.leapfrog.max_rounds);
+    r.add(sec, "drag", v.leapfrog.drag, "1/t_c");
+  }
+  const magnetism::MagnetizationOptions& m = v.magnetization;
+  r.add(sec, "magnetization_atol", m.atol, "Ms");
+  r.add(sec, "magnetization_rtol", m.rtol, "");
+  r.add_text(sec, "magnetization_iterations",
+             fmt::format("{} fixed point, {} Anderson, {} Newton", m.max_fixed_point_iterations,
+                         m.max_anderson_iterations, m.max_newton_iterations),
+             "per method of the fallback chain");
+  r.add_text(sec, "magnetization_check_stability", m.check_stability ? "on" : "off");
+}
+
+// The estimate a run is checked against (check_memory), and the memory available now.
+void describe_memory(const MessSpec& s, app::InfoReport& r) {
+  constexpr double kMiB = 1 << 20;
+  r.add("memory", "estimate", static_cast<double>(estimated_memory_bytes(s)) / kMiB, "MiB",
+        fmt::format("{:.0f} MiB + {} bytes per node + 32 (3N)^2 bytes for N particles",
+                    static_cast<double>(kFixedBytes) / kMiB, kBytesPerNode));
+  const AvailableMemory available = available_memory();
+  if (available.bytes) {
+    r.add("memory", "available", static_cast<double>(*available.bytes) / kMiB, "MiB",
+          available.source + "; a run needing more is refused");
+  } else {
+    r.add_text("memory", "available", "unknown", "no check");
+  }
+}
+
+}  // namespace
+
+void describe_mess(const MessSpec& s, app::InfoReport& r) {
+  r.add_text("mess", "run_type", run_type_name(s.run_type));
+  r.add_integer("mess", "relaxations", static_cast<std::int64_t>(s.relaxation_count()), "",
+                s.load_step_count() > 1 ? fmt::format("{} fields x {} load values",
+                                                      s.field.values.size(), s.load_step_count())
+                                        : "one per field");
+  describe_lattice(s, r);
+  describe_memory(s, r);
+  describe_stiffness(s, r);
+  describe_scales(s, r);
+  describe_particles(s, r);
+  describe_field(s, r);
+  describe_loads(s, r);
+  describe_solver(s, r);
+  r.add_text("output", "node_positions", s.output.node_positions ? "on" : "off",
+             s.output.node_positions
+                 ? fmt::format("{:.3g} MB per step (float64)",
+                               24.0 * static_cast<double>(s.geometry.node_count()) / 1e6)
+                 : "");
+  r.add_integer("output", "checkpoint_every", s.output.checkpoint_every, "steps",
+                s.output.checkpoint_every == 0 ? "no checkpoints" : "");
+  for (std::size_t i = 0; i < s.warnings.size(); ++i) {
+    r.add_text("warnings", fmt::format("warning_{}", i), s.warnings[i]);
+  }
+}
+
+}  // namespace mresim::mess_config

@@ -1,0 +1,293 @@
+#pragma once
+
+// The run file of the 3D model (MESS, Chapter 4): reading, validating and describing it.
+//
+// The four run types of the 3D model ([run] type = "mess_hysteresis", "mess_strain",
+// "mess_magnetostriction", "mess_stress") share one schema, documented key by key in
+// docs/run-files-3d.md. This module turns a run file into a plain MessSpec that holds every
+// parameter those run types need, already validated, and describes it for `mresim info`
+// without relaxing anything. It registers no run type: the run types (with the solvers of
+// src/mresim/mess/) call
+//
+//   MessSpec spec = read_mess_spec(root, settings.type);   // in their PlanFactory
+//   describe_mess(spec, report);                           // in RunPlan::describe
+//   lattice::Lattice lat = lattice::build_lattice(spec.lattice);   // in execute()
+//
+// Everything is SI (m, Pa, A/m, T, kg) except where a key says otherwise (angles in degrees
+// in the file, stored in radians where noted; leapfrog settings in the seed's scaled units).
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "mresim/app/info_report.hpp"
+#include "mresim/config/table_reader.hpp"
+#include "mresim/mess/lattice/lattice.hpp"
+#include "mresim/mess/magnetization/magnetic_particles.hpp"
+#include "mresim/mess/magnetization/self_consistent.hpp"
+#include "mresim/mess/profile/model_profile.hpp"
+#include "mresim/mess/terms/magnetic_energy.hpp"
+
+namespace mresim::mess_config {
+
+// ---------------------------------------------------------------------------------------------
+// Run types
+
+enum class MessRunType { hysteresis, strain, magnetostriction, stress };
+
+// "mess_hysteresis", "mess_strain", "mess_magnetostriction", "mess_stress".
+std::string run_type_name(MessRunType type);
+// The four names above, in that order.
+const std::vector<std::string>& mess_run_type_names();
+// std::nullopt for any other name.
+std::optional<MessRunType> parse_run_type(std::string_view name);
+
+// ---------------------------------------------------------------------------------------------
+// [field]: the sequence of applied fields
+
+// How the magnitudes list becomes the applied sequence.
+enum class FieldSequence {
+  loop,  // u, reversed u, -u, reversed -u, u: 5 (n - 1) + 1 fields
+         // (docs/original-code.md#field-sequences)
+  up,    // u as given
+};
+
+struct FieldSpec {
+  enum class Form { max_and_steps, magnitudes, vectors };
+  Form form = Form::max_and_steps;
+  // Forms max_and_steps and magnitudes: the upward list u (T) and the direction.
+  std::vector<double> magnitudes;  // T; max_and_steps: 0, max/steps, ..., max
+  double max = 0.0;                // T (the largest magnitude of u; of |B| for vectors)
+  long steps = 0;                  // max_and_steps only
+  double theta_deg = 0.0;          // polar angle from +z
+  double phi_deg = 0.0;            // azimuth from +x
+  FieldSequence sequence = FieldSequence::loop;
+  // The applied fields B_ext = mu0 H_ext in tesla, in the order they are applied (for
+  // mess_strain and mess_stress: the inner loop, repeated at every strain or stress value).
+  std::vector<Eigen::Vector3d> values;
+};
+
+// The applied sequence of a loop over u (u[0] must be 0): u, u reversed without its last, -u
+// without its first, -u reversed without its last, u without its first.
+std::vector<double> hysteresis_loop(const std::vector<double>& up);
+// B (sin theta cos phi, sin theta sin phi, cos theta), angles in degrees.
+Eigen::Vector3d field_vector(double magnitude, double theta_deg, double phi_deg);
+
+// ---------------------------------------------------------------------------------------------
+// [strain] (mess_strain) and [stress] (mess_stress)
+
+enum class LoadKind { shear, tension, compression, torsion };
+std::string to_string(LoadKind kind);
+
+// Which surfaces a shear strain holds (docs/original-code.md#boundary-conditions).
+enum class ShearBoundary {
+  all_faces,     // every surface node follows u = h tan(gamma) (the original's
+                 // strain_simple_shearing; the dissertation's simple shear, eq. 4.96)
+  normal_faces,  // only the two faces normal to `normal` are held, the lower one fixed, the
+                 // upper one displaced by L tan(gamma); the side faces are free (strain_shearing)
+};
+
+struct StrainSpec {
+  LoadKind kind = LoadKind::shear;
+  int normal = 2;     // axis of the surface normal (0 = x, 1 = y, 2 = z): the loaded faces
+  int direction = 0;  // shear: displacement axis (!= normal); otherwise equal to normal
+  ShearBoundary boundary = ShearBoundary::all_faces;  // shear only
+  // Applied values, first 0: shear angle gamma (rad, u = h tan gamma); tension and compression
+  // the engineering strain along `normal` (compression stored negative); torsion the twist of
+  // the upper face about the box's axis along `normal` (rad, right-handed about +normal).
+  std::vector<double> values;
+};
+
+// Where a stress is applied (docs/original-code.md#boundary-conditions).
+enum class StressLoading {
+  one_face,    // lower face fixed, traction on the upper face (simple_stress_*)
+  both_faces,  // opposite tractions on both faces, nothing fixed (special_stress_*); shear also
+               // loads the pair of faces normal to `direction`, along `normal`
+};
+
+struct StressSpec {
+  LoadKind kind = LoadKind::shear;  // shear, tension or compression
+  int normal = 2;
+  int direction = 0;
+  StressLoading loading = StressLoading::one_face;
+  // Pa, first 0; tension positive, compression stored negative, shear signed along direction.
+  std::vector<double> values;
+};
+
+// ---------------------------------------------------------------------------------------------
+// [solver] and [output]
+
+enum class SolverMethod { minimiser, leapfrog };
+
+struct MinimiserSettings {
+  // Converged when the largest net force on a free node is below force_tolerance * k_eff l_e
+  // (the characteristic force of the seed's scaling,
+  // docs/original-code.md#lengths-spring-constants-and-scaling).
+  double force_tolerance = 1e-6;
+  long max_iterations = 100000;
+};
+
+// The seed's damped leapfrog (docs/original-code.md#time-integration, #convergence), in its scaled
+// units.
+struct LeapfrogSettings {
+  double dt = 5e-3;             // units of t_c
+  long steps_per_round = 5000;  // time steps between convergence checks
+  long max_rounds = 40;         // integration rounds per field/strain step
+  double drag = 1.0;            // units of 1/t_c
+};
+
+// The seed profile's leapfrog stability limit dt < 2/omega_max in units of t_c for
+// discretization orders 2-5 (4.8e-3, 5.6e-3, 5.7e-3, 5.8e-3); std::nullopt for other orders,
+// where it is not known. The reader refuses leapfrog.dt at or above it (seed profile only).
+std::optional<double> leapfrog_stability_limit(int discretization_order);
+
+struct SolverSpec {
+  SolverMethod method = SolverMethod::minimiser;
+  MinimiserSettings minimiser;
+  LeapfrogSettings leapfrog;
+  // atol, rtol, iteration budgets; `demagnetization` mirrors MessSpec::demagnetization.
+  magnetism::MagnetizationOptions magnetization;
+};
+
+struct OutputSpec {
+  bool node_positions = false;  // write all node positions per step (large)
+  long checkpoint_every = 1;    // steps between checkpoints; 0 = none
+};
+
+// ---------------------------------------------------------------------------------------------
+// Derived geometry (computed while reading: it is what validates the placement)
+
+// Springs that get the particle constants, by kind (a subset of the closed-form totals).
+struct ParticleSpringCounts {
+  std::int64_t edge = 0;
+  std::int64_t face = 0;
+  std::int64_t body = 0;
+  std::int64_t total() const { return edge + face + body; }
+};
+
+struct MessGeometry {
+  double element_length = 0.0;  // l_e, m
+  lattice::GridShape shape;
+  Eigen::Vector3d box_lengths = Eigen::Vector3d::Zero();  // (N_a - 1) l_e, m
+  std::vector<std::array<int, 3>> centre_cells;           // cell holding each particle centre
+  std::vector<Eigen::Vector3d> particle_centres;          // centres of those cells, m
+  std::int64_t nodes_per_particle = 0;
+  lattice::SpringCounts springs;          // all springs of the box (closed forms)
+  ParticleSpringCounts particle_springs;  // of which with the particle constants
+  double volume_fraction = 0.0;           // N V_p / (L_x L_y L_z) of the lattice (eq. 4.50)
+
+  std::int64_t node_count() const { return shape.node_count(); }
+  std::int64_t cell_count() const { return shape.cell_count(); }
+  std::size_t particle_count() const { return centre_cells.size(); }
+};
+
+// At most this many nodes (a run needs ~1,600 bytes each: kBytesPerNode, check_memory); larger
+// boxes are rejected before anything of that size is allocated.
+inline constexpr std::int64_t kMaxNodes = 100'000'000;
+
+// Sizes the box, places and voxelizes the particles (lattice::place_particles) and counts the
+// springs, without building the lattice: fast even for the 1M-node helix. Throws
+// std::invalid_argument as the lattice does (invalid parameters, a particle outside the box,
+// overlapping particles, more than kMaxNodes nodes).
+MessGeometry derive_geometry(const lattice::LatticeSpec& spec);
+
+// ---------------------------------------------------------------------------------------------
+// The whole run file
+
+// Regular placements: the actual volume fraction of the lattice may differ from
+// particles.volume_fraction by this much (relative) before the reader warns.
+inline constexpr double kVolumeFractionTolerance = 0.01;
+
+// particles.radius must lie in [kMinRadius, kMaxRadius] m: l_e, R^3 and R^6 (products of two
+// dipole moments) stay normal doubles with room for the other factors.
+inline constexpr double kMinRadius = 1e-30;
+inline constexpr double kMaxRadius = 1e30;
+
+struct MessSpec {
+  MessRunType run_type = MessRunType::hysteresis;
+  std::string title;  // [run].title
+
+  // [model] profile: the table entry, read once here and passed down (never compared by name).
+  const mess::ModelProfile* profile = &mess::model_profile("physical");
+  // [model], the particle radius and the placement: ready for lattice::build_lattice (the
+  // profile's lattice rules already written in).
+  lattice::LatticeSpec lattice;
+  lattice::PlacementKind placement_kind = lattice::PlacementKind::regular;
+  std::optional<double> requested_volume_fraction;  // regular placements
+  std::optional<lattice::BoxSpec> box;              // [box], by_hand / chain / helix
+
+  // [particles], magnetic part. particles.radius == lattice.particle_radius.
+  magnetism::MagneticParticles particles;
+  bool demagnetization = false;
+  magnetism::SelfEnergyForm self_energy = magnetism::SelfEnergyForm::consistent;
+
+  FieldSpec field;
+  std::optional<StrainSpec> strain;  // mess_strain only
+  std::optional<StressSpec> stress;  // mess_stress only
+  SolverSpec solver;
+  OutputSpec output;
+
+  MessGeometry geometry;
+
+  // Read-time warnings (input that the model changes, e.g. the actual volume fraction of a
+  // regular placement), one line each without "mresim: warning: "; the run type prints them and
+  // records them in results.h5 /@warnings.
+  std::vector<std::string> warnings;
+
+  // Load values (strain or stress; 1 for the other run types).
+  std::size_t load_step_count() const;
+  // Relaxations the run performs: fields x load values.
+  std::size_t relaxation_count() const;
+};
+
+// Reads every table of the 3D schema except [run] ([model], [particles], [box], [field],
+// [strain] or [stress], [solver], [output]) for the run type `run_type` (one of
+// mess_run_type_names(); anything else is a programming error: std::invalid_argument).
+// Throws config::ConfigError for any invalid input, naming the key. Does not reject unknown
+// keys: app::make_plan does that after the factory returns.
+MessSpec read_mess_spec(const config::TableReader& root, std::string_view run_type);
+
+// What app::make_plan will do once the run types are registered: reads [run] (type one of the
+// four names, title, threads), then read_mess_spec, then rejects unknown keys anywhere.
+MessSpec read_mess_run_file(const config::TableReader& root);
+
+// ---------------------------------------------------------------------------------------------
+// Memory (docs/run-files-3d.md, "Memory"): a run is refused before anything is allocated or
+// written when its estimated peak exceeds the memory available to the process.
+
+// Measured peak resident memory of a 3D run with the minimiser, per lattice node (nodes,
+// springs, cells, forces, the minimiser's history and the checkpoint copy together; the slope of
+// peak RSS between an 18,081- and a 58,621-node run is 1,513 bytes), rounded up.
+inline constexpr std::int64_t kBytesPerNode = 1600;
+// The process itself (libraries, HDF5, buffers): peak RSS of the 1,800-node run is 20 MB.
+inline constexpr std::int64_t kFixedBytes = 32LL << 20;
+
+// kFixedBytes + kBytesPerNode x nodes + the magnetization solve's dense 3N x 3N matrices
+// (Hessian, its factorization, the eigen-decomposition and Anderson's history: 4 x 8 (3N)^2
+// bytes for N particles).
+std::int64_t estimated_memory_bytes(const MessSpec& spec);
+
+struct AvailableMemory {
+  std::optional<std::int64_t> bytes;  // std::nullopt: unknown (no check)
+  std::string source;                 // "MRESIM_MEMORY_LIMIT", "MemAvailable", "cgroup memory.max"
+};
+// MRESIM_MEMORY_LIMIT (bytes, a positive integer) when set; otherwise the smaller of MemAvailable
+// in /proc/meminfo and the cgroup limit /sys/fs/cgroup/memory.max. Throws config::ConfigError for
+// an MRESIM_MEMORY_LIMIT that is not a positive integer.
+AvailableMemory available_memory();
+
+// Throws config::ConfigError (one line: nodes, the estimate, the memory available and where that
+// figure comes from) when estimated_memory_bytes(spec) exceeds `available`.
+void check_memory(const MessSpec& spec, const AvailableMemory& available);
+
+// Adds to `report` everything the spec implies without running: lattice counts (nodes, cells,
+// springs by kind), l_e, spring constants and kappa of the profile and the lattice moduli they
+// give, the characteristic scales (m_c, k_eff, t_c), system size, particles and their centres,
+// the actual volume fraction, the field and load sequences and the solver settings.
+void describe_mess(const MessSpec& spec, app::InfoReport& report);
+
+}  // namespace mresim::mess_config

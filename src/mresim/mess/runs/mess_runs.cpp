@@ -1,0 +1,127 @@
+// Run types of the 3D model (Chapter 4): mess_hysteresis, mess_strain, mess_magnetostriction,
+// mess_stress. One plan for all four: the run file's MessSpec says which protocol the
+// ProtocolRunner follows. Checkpoints go to the staging directory after every
+// [output] checkpoint_every steps; `mresim resume` hands the interrupted staging directory back
+// to execute(), which continues from its checkpoint.
+
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "mresim/app/invalid_results.hpp"
+#include "mresim/app/run_type.hpp"
+#include "mresim/app/stop_signal.hpp"
+#include "mresim/mess/run_file/mess_spec.hpp"
+#include "mresim/mess/outputs/checkpoint.hpp"
+#include "mresim/mess/outputs/mess_outputs.hpp"
+#include "mresim/mess/protocols/protocol_runner.hpp"
+#include "mresim/pair/runs/pair_outputs.hpp"
+
+namespace mresim::mess_protocol {
+namespace {
+
+namespace fs = std::filesystem;
+namespace mc = mresim::mess_config;
+
+class MessPlan final : public app::RunPlan {
+ public:
+  MessPlan(const config::TableReader& root, std::string_view type)
+      : spec_(mc::read_mess_spec(root, type)),
+        input_toml_(root.source_text()),
+        input_name_(root.source_name()) {
+    // Refuse what cannot fit before the lattice is allocated or anything is written.
+    mc::check_memory(spec_, mc::available_memory());
+  }
+
+  void describe(app::InfoReport& report) const override { mc::describe_mess(spec_, report); }
+
+  void execute(const fs::path& staging_dir, io::Hdf5File& results,
+               app::Progress& progress) const override {
+    // Read-time warnings: printed here, not in the constructor, so that `info` (which lists
+    // them) and a run file refused later by make_plan print only their own lines.
+    pair::runs::print_warnings(spec_.warnings);
+    ProtocolRunner runner(spec_);
+    const fs::path checkpoint = staging_dir / kCheckpointFile;
+    ProtocolState state = fs::exists(checkpoint) ? read_checkpoint(checkpoint, runner, input_toml_)
+                                                 : runner.initial_state();
+    const std::size_t total = runner.steps().size();
+    if (state.next_step > 0) {
+      std::cerr << fmt::format("mresim: resuming at step {} of {} from the checkpoint\n",
+                               state.next_step, total);
+    }
+    progress.set_total(total);
+    progress.advance(state.next_step);
+
+    const long every = spec_.output.checkpoint_every;
+    runner.run(state, [&](const ProtocolState& s) {
+      if (spec_.output.node_positions) {
+        write_step_positions(staging_dir, s.records.back().step.index, runner.system().positions());
+      }
+      if (every > 0 && s.next_step < total && s.next_step % static_cast<std::size_t>(every) == 0) {
+        write_checkpoint(checkpoint, s, runner, input_toml_, input_name_);
+      }
+      progress.advance();
+      // SIGINT/SIGTERM: a step boundary is the safe point; checkpoint (whatever checkpoint_every
+      // says) so that `mresim resume` continues from here.
+      if (app::stop_requested() && s.next_step < total) {
+        write_checkpoint(checkpoint, s, runner, input_toml_, input_name_);
+        throw app::Interrupted(app::stop_signal(), true,
+                               fmt::format("after step {} of {}", s.next_step, total));
+      }
+    });
+
+    const MessResultCheck check = write_mess_results(staging_dir, results, runner, state.records);
+    pair::runs::write_warnings_attribute(results, spec_.warnings);  // /@warnings, as pair runs
+    warn_about_intermediate_solves(state.records);
+    for (const std::string& fit : check.invalid_fits) {
+      std::cerr << "mresim: warning: invalid modulus fit, not a result: " << fit
+                << " (marked in /analysis/valid and modulus.csv)\n";
+    }
+    std::error_code ec;
+    fs::remove(checkpoint, ec);  // the results hold everything now
+    // Non-finite or unconverged steps: the results stay, marked; `mresim run` exits with 4.
+    const std::string invalid = check.message();
+    if (!invalid.empty()) throw app::InvalidResults(invalid);
+  }
+
+ private:
+  // A magnetization solve that missed its tolerance during a step whose final solve converged
+  // leaves a valid step; it is reported, not an error.
+  static void warn_about_intermediate_solves(const std::vector<StepRecord>& records) {
+    std::size_t magnetization = 0;
+    for (const StepRecord& r : records) {
+      if (r.unconverged_magnetization_solves > 0) ++magnetization;
+    }
+    if (magnetization > 0) {
+      std::cerr << fmt::format(
+          "mresim: warning: in {} of {} steps some magnetization solve missed its tolerance "
+          "(see /steps/solver/unconverged_magnetization_solves)\n",
+          magnetization, records.size());
+    }
+  }
+
+  mc::MessSpec spec_;
+  std::string input_toml_;
+  std::string input_name_;
+};
+
+app::RunType mess_run_type(const char* name, const char* summary) {
+  return {name, summary, [name](const config::TableReader& root) {
+            return std::make_unique<MessPlan>(root, name);
+          }};
+}
+
+const app::RunTypeRegistrar hysteresis(mess_run_type(
+    "mess_hysteresis", "3D lattice (MESS): field loop with all faces held (Chapter 4)"));
+const app::RunTypeRegistrar strain(mess_run_type(
+    "mess_strain", "3D lattice (MESS): shear, tension, compression or torsion; G_eff / E_eff"));
+const app::RunTypeRegistrar magnetostriction(mess_run_type(
+    "mess_magnetostriction", "3D lattice (MESS): field series with only the bottom face held"));
+const app::RunTypeRegistrar stress(mess_run_type(
+    "mess_stress", "3D lattice (MESS): applied shear, tension or compression stress"));
+
+}  // namespace
+}  // namespace mresim::mess_protocol

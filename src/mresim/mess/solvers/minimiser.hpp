@@ -1,0 +1,127 @@
+#pragma once
+
+// Fast relaxation of the 3D system to a local minimum of its potential (system_energy.hpp):
+// L-BFGS (default) or FIRE, on scaled variables (lengths in units of l_e, energies in units of
+// E0 = k_eff l_e^2, so scaled gradients are forces in units of F0 = k_eff l_e), with the particle
+// magnetizations re-solved between outer iterations. The seed's damped leapfrog
+// (leapfrog.hpp) reaches the same states with far more force evaluations.
+//
+//  - lbfgs: limited-memory BFGS (Nocedal & Wright, Numerical Optimization, Alg. 7.4-7.5) with a
+//    strong-Wolfe line search (Alg. 3.5-3.6), preconditioned by RigidParticlePreconditioner
+//    (initial inverse Hessian gamma P: Jacobi scaling plus the particles' rigid motions at the
+//    polymer's stiffness; 25-30x fewer iterations with particles, preconditioner.hpp). The
+//    line search tolerates rounding noise in the energy: sufficient decrease is tested with a
+//    slack of a few ulps of the energy's terms and the zoom interpolates the directional
+//    derivative, so it keeps making progress where energy differences are below the energy's
+//    rounding error. Hand-written on Eigen: Debian's LBFGS++ (liblbfgspp-dev) would add a
+//    build dependency and lacks the preconditioned initial Hessian and the noise-tolerant search.
+//  - fire: the Fast Inertial Relaxation Engine (Bitzek et al., PRL 97, 170201 (2006)) with the
+//    semi-implicit Euler step and the uphill correction of FIRE 2.0 (Guenole et al., Comput.
+//    Mater. Sci. 175, 109584 (2020)), nodal masses as in the dynamics, dt_max from the highest
+//    lattice frequency (power iteration). Needs only forces, so it also relaxes the seed's
+//    non-conservative force field (CentreRule::centre_voxel) exactly. Not preconditioned: with
+//    particles it needs 30-50x more iterations than lbfgs.
+//
+// Seed profile (CentreRule::centre_voxel): its spread particle forces are not exactly the
+// potential's gradient (they differ by the particles' internal deformation), which L-BFGS's
+// line search cannot live with. L-BFGS therefore relaxes the conservative neighbour (centre =
+// mean of all nodes) first; then the seed's own forces are evaluated and, if above the
+// tolerance, L-BFGS continues on them with a slope-only line search (no energy tests:
+// forces_only_phase), and FIRE finishes should that fail too. The result always meets the
+// tolerance on the profile's own forces.
+//
+// Fallbacks, reported in MinimiserResult: when the L-BFGS line search fails or stalls, with
+// every_evaluation coupling the minimiser switches to alternating; if it fails again, FIRE
+// finishes from where L-BFGS stopped.
+//
+// Magnetization (MagnetizationCoupling):
+//  - every_evaluation (default): M is re-solved (with history) at every evaluation, i.e. the
+//    reduced energy E(x, M(x)) is minimised; its gradient is the fixed-M gradient by the
+//    envelope theorem. M solved to a finite tolerance makes E(x, M(x)) slightly rough (the
+//    solver returns its history unchanged while that is within tolerance); should the line
+//    search stall on it, the minimiser switches to alternating for the rest of the call.
+//  - alternating: the inner minimisation runs at fixed M; between outer iterations M is
+//    re-solved and the forces re-checked (block-coordinate descent on E(x, M)). About 2-3 times
+//    more iterations when M changes a lot during the relaxation.
+//
+// Convergence (checked with the current M after it has been re-solved): the largest force on
+// any free coordinate, the net force on any rigid group and the net force on any particle are
+// all <= force_tolerance x force_scale, AND the potential changed by at most
+// energy_tolerance x max(sum of |terms|, E0) over the last iteration (E0 = force_scale l_e; the
+// floor keeps tiny energies, dominated by their own rounding, from blocking convergence).
+
+#include <cstdint>
+#include <string>
+
+#include "mresim/mess/system/system_energy.hpp"
+
+namespace mresim::mess {
+
+enum class MinimiserMethod { lbfgs, fire };
+enum class MagnetizationCoupling { alternating, every_evaluation };
+// stalled: 50 L-BFGS iterations without a new smallest force or an energy decrease beyond
+// rounding (the tolerance is below what the configuration's rounding allows).
+enum class MinimiserStatus { converged, max_iterations, line_search_failed, stalled, not_finite };
+
+std::string to_string(MinimiserMethod method);
+std::string to_string(MinimiserStatus status);
+
+// Bitzek et al. (2006) parameters.
+struct FireParameters {
+  int n_min = 5;
+  double f_inc = 1.1;
+  double f_dec = 0.5;
+  double alpha_start = 0.1;
+  double f_alpha = 0.99;
+  // Time step limit in units of 1/omega_max (omega_max estimated by power iteration on the
+  // mass-weighted Hessian); semi-implicit Euler is stable below 2.
+  double dt_max_factor = 1.0;
+  double dt_start_factor = 0.25;
+  int power_iterations = 30;
+};
+
+struct MinimiserOptions {
+  MinimiserMethod method = MinimiserMethod::lbfgs;
+  double force_tolerance = 1e-6;    // relative to force_scale
+  double energy_tolerance = 1e-10;  // relative to max(sum of |terms| of the potential, E0)
+  // N; <= 0: F0 = k_eff l_e, k_eff = 2 k_e + 8 k_f/sqrt(2) + 4 k_c of the polymer (eq. 4.95;
+  // the run files' "characteristic force").
+  double force_scale = 0.0;
+  int max_iterations = 200000;  // inner iterations, all outer iterations together
+  int max_outer_iterations = 50;
+  MagnetizationCoupling coupling = MagnetizationCoupling::every_evaluation;
+  int lbfgs_memory = 10;
+  // L-BFGS only: initial inverse Hessian from RigidParticlePreconditioner (preconditioner.hpp).
+  bool precondition = true;
+  double max_step = 0.2;  // largest coordinate change per iteration, in units of l_e
+  FireParameters fire;
+
+  void validate() const;  // throws std::invalid_argument naming the option
+};
+
+struct MinimiserResult {
+  MinimiserStatus status = MinimiserStatus::max_iterations;
+  bool converged = false;
+  int iterations = 0;        // inner iterations (L-BFGS steps or FIRE steps)
+  int outer_iterations = 0;  // magnetization re-solves between minimisations (alternating)
+  bool switched_to_alternating = false;   // every_evaluation fell back to alternating
+  bool forces_only_phase = false;         // seed: L-BFGS continued on the seed's own forces
+  bool finished_with_fire = false;        // lbfgs's line search failed; FIRE finished
+  std::int64_t evaluations = 0;           // energy + gradient evaluations
+  double max_force = 0.0;                 // N, the convergence measure at the end
+  double force_scale = 0.0;               // N
+  double energy_change = 0.0;             // J, potential change over the last iteration
+  Evaluation final;                       // energies at the end (current M)
+  std::int64_t magnetization_solves = 0;  // during this call
+  std::int64_t unconverged_magnetization_solves = 0;
+};
+
+// Relaxes system.positions() (free coordinates and rigid groups; held coordinates stay) and
+// its magnetizations. The system's MagnetizationUpdate is restored on return.
+MinimiserResult minimise(MessSystem& system, const MinimiserOptions& options = {});
+
+// The convergence measure: max over free coordinates, rigid-group net forces and particle net
+// forces of |dE/dx| (N), from a full gradient (3 x N).
+double max_free_force(const MessSystem& system, const Eigen::Matrix3Xd& gradient);
+
+}  // namespace mresim::mess

@@ -1,0 +1,102 @@
+#include "mresim/mess/solvers/preconditioner.hpp"
+
+#include <Eigen/Geometry>
+#include <Eigen/QR>
+#include <cmath>
+
+namespace mresim::mess {
+
+RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& system,
+                                                         const DofMap& map, double force_scale) {
+  const lattice::Lattice& lat = system.lattice();
+  const Eigen::Matrix3Xd& x0 = lat.positions;
+  const double l_e = lat.element_length;
+  // Hessian diagonal per node coordinate (N/m) at the reference configuration.
+  Eigen::Matrix3Xd d = Eigen::Matrix3Xd::Zero(3, lat.node_count());
+  const lattice::SpringSet& sp = lat.springs;
+  for (std::size_t s = 0; s < sp.size(); ++s) {
+    const Eigen::Vector3d e = (x0.col(sp.second[s]) - x0.col(sp.first[s])).normalized();
+    const Eigen::Vector3d h = sp.stiffness[s] * e.cwiseAbs2();
+    d.col(sp.first[s]) += h;
+    d.col(sp.second[s]) += h;
+  }
+  // Volume term: kappa V0 (dV/dx / V0)^2 with |dV/dx_a| = l_e^2/4 at rest, per cell.
+  const double cell =
+      system.settings().elastic.volume_force_factor * std::abs(lat.polymer.kappa) * l_e / 16.0;
+  for (const auto& e : lat.elements) {
+    for (const std::int32_t n : e) d.col(n).array() += cell;
+  }
+
+  // Per dof (group dofs: sum over the group's nodes), scaled.
+  const double scale = l_e / force_scale;
+  diagonal_ = Eigen::VectorXd::Zero(map.size());
+  double polymer_sum = 0.0;
+  std::int64_t polymer_count = 0;
+  for (std::int64_t n = 0; n < lat.node_count(); ++n) {
+    const bool particle =
+        !lat.particle_of_node.empty() && lat.particle_of_node[static_cast<std::size_t>(n)] >= 0;
+    for (int a = 0; a < 3; ++a) {
+      const Eigen::Index k = map.dof_of(n, a);
+      if (k < 0) continue;
+      diagonal_[k] += d(a, n) * scale;
+      if (!particle) {
+        polymer_sum += d(a, n) * scale;
+        ++polymer_count;
+      }
+    }
+  }
+  for (Eigen::Index k = 0; k < diagonal_.size(); ++k) {
+    if (!(diagonal_[k] > 0.0)) diagonal_[k] = 1.0;
+  }
+  inverse_diagonal_ = diagonal_.cwiseInverse();
+  rigid_stiffness_ = polymer_count > 0 ? polymer_sum / static_cast<double>(polymer_count) : 1.0;
+
+  // Rigid-motion bases of the particles whose coordinates are all plain free dofs.
+  for (const auto& nodes : lat.particle_nodes) {
+    Block b;
+    bool free = true;
+    for (const std::int32_t n : nodes) {
+      for (int a = 0; a < 3; ++a) {
+        const Eigen::Index k = map.dof_of(n, a);
+        if (k < 0 || map.is_group_dof(k)) free = false;
+        b.dofs.push_back(k);
+      }
+    }
+    if (!free) continue;
+    const auto np = static_cast<Eigen::Index>(nodes.size());
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (const std::int32_t n : nodes) centre += x0.col(n);
+    centre /= static_cast<double>(np);
+    Eigen::MatrixXd r = Eigen::MatrixXd::Zero(3 * np, 6);
+    for (Eigen::Index i = 0; i < np; ++i) {
+      const Eigen::Vector3d p = (x0.col(nodes[static_cast<std::size_t>(i)]) - centre) / l_e;
+      r.block<3, 3>(3 * i, 0).setIdentity();
+      // Rotation about axis c: omega_c x p.
+      r.block<3, 1>(3 * i, 3) = Eigen::Vector3d::UnitX().cross(p);
+      r.block<3, 1>(3 * i, 4) = Eigen::Vector3d::UnitY().cross(p);
+      r.block<3, 1>(3 * i, 5) = Eigen::Vector3d::UnitZ().cross(p);
+    }
+    b.q = Eigen::HouseholderQR<Eigen::MatrixXd>(r).householderQ() *
+          Eigen::MatrixXd::Identity(3 * np, 6);
+    blocks_.push_back(std::move(b));
+  }
+}
+
+Eigen::VectorXd RigidParticlePreconditioner::apply(const Eigen::VectorXd& v) const {
+  Eigen::VectorXd w = inverse_diagonal_.cwiseProduct(v);
+  for (const Block& b : blocks_) {
+    const auto m = static_cast<Eigen::Index>(b.dofs.size());
+    Eigen::VectorXd vp(m);
+    for (Eigen::Index i = 0; i < m; ++i) vp[i] = v[b.dofs[static_cast<std::size_t>(i)]];
+    const Eigen::VectorXd t = b.q.transpose() * vp;
+    Eigen::VectorXd internal = vp - b.q * t;
+    for (Eigen::Index i = 0; i < m; ++i)
+      internal[i] *= inverse_diagonal_[b.dofs[static_cast<std::size_t>(i)]];
+    internal -= b.q * (b.q.transpose() * internal);
+    const Eigen::VectorXd wp = internal + b.q * (t / rigid_stiffness_);
+    for (Eigen::Index i = 0; i < m; ++i) w[b.dofs[static_cast<std::size_t>(i)]] = wp[i];
+  }
+  return w;
+}
+
+}  // namespace mresim::mess

@@ -1,0 +1,52 @@
+#pragma once
+
+// A preconditioner for the minimisers: an approximate inverse of the lattice's Hessian in the
+// free variables, used as the initial inverse Hessian of L-BFGS (H0 = gamma P).
+//
+// Why. Particle springs are 1e4 times stiffer than the polymer's (Section 4.2.2), so the
+// Hessian's eigenvalues span the particles' internal modes (~1e4 k) down to the polymer's
+// long-wave modes, and an unpreconditioned L-BFGS needs ~20 times more iterations with
+// particles than without (measured on small blocks). A plain diagonal (Jacobi) scaling fixes
+// the internal modes but makes each particle's *rigid* motions, which only the soft polymer
+// resists, 1e4 times too slow. So:
+//
+//   P = D^-1                                   on dofs outside fully free particles,
+//   P = (I - Q Q^T) D^-1 (I - Q Q^T) + Q Q^T / h   on each fully free particle's 3 n_p dofs,
+//
+// with D the Hessian diagonal of springs and volume term at the reference configuration
+// (springs: sum k e_a^2 over a node's springs, e the rest direction; volume: force factor x
+// kappa l_e / 16 per cell at the node), Q an orthonormal basis of the particle's 6 rigid motions
+// (3 translations, 3 rotations about its centre) and h the mean polymer diagonal (the rigid
+// modes are resisted by the polymer alone). P is symmetric positive definite.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "mresim/mess/system/constraints.hpp"
+#include "mresim/mess/system/system_energy.hpp"
+
+namespace mresim::mess {
+
+class RigidParticlePreconditioner {
+ public:
+  // Diagonal from the lattice's springs and cells; scaled like the minimiser's variables
+  // (gradient in units of force_scale per l_e): D_scaled = D l_e / force_scale.
+  RigidParticlePreconditioner(const MessSystem& system, const DofMap& map, double force_scale);
+
+  // P v.
+  Eigen::VectorXd apply(const Eigen::VectorXd& v) const;
+
+  const Eigen::VectorXd& diagonal() const { return diagonal_; }
+
+ private:
+  Eigen::VectorXd inverse_diagonal_;
+  Eigen::VectorXd diagonal_;
+  double rigid_stiffness_ = 1.0;
+  struct Block {
+    std::vector<Eigen::Index> dofs;  // 3 n_p, node by node
+    Eigen::MatrixXd q;               // 3 n_p x 6, orthonormal
+  };
+  std::vector<Block> blocks_;
+};
+
+}  // namespace mresim::mess

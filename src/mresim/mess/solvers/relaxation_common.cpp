@@ -1,0 +1,55 @@
+#include "mresim/mess/solvers/relaxation_common.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace mresim::mess::detail {
+
+double characteristic_mass(const lattice::Lattice& lat) {
+  const auto& shape = lat.shape;
+  for (std::int64_t n = 0; n < lat.node_count(); ++n) {
+    if (!lat.particle_of_node.empty() && lat.particle_of_node[static_cast<std::size_t>(n)] >= 0) {
+      continue;
+    }
+    const auto c = shape.node_coordinates(static_cast<int>(n));
+    int cells = 1;  // cells at the node: 2 per axis inside, 1 on a face of that axis
+    for (int a = 0; a < 3; ++a) cells *= (c[a] == 0 || c[a] == shape.nodes[a] - 1) ? 1 : 2;
+    return lat.masses[n] * 8.0 / cells;
+  }
+  throw std::invalid_argument("characteristic_mass: the lattice has no polymer node");
+}
+
+ForceMeasure::ForceMeasure(const MessSystem& system, const DofMap& map)
+    : map_(map), particles_(system.lattice().particle_nodes), fixed_(system.constraints().fixed) {}
+
+double ForceMeasure::max_force(const Eigen::Matrix3Xd& gradient) const {
+  double m = 0.0;
+  const Eigen::VectorXd reduced = map_.reduce(gradient) / map_.length_scale();
+  if (reduced.size() > 0) m = reduced.cwiseAbs().maxCoeff();
+  for (const auto& nodes : particles_) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const std::int32_t n : nodes) {
+      for (int a = 0; a < 3; ++a) {
+        if (fixed_.empty() || fixed_[3 * static_cast<std::size_t>(n) + a] == 0) {
+          sum[a] += gradient(a, n);
+        }
+      }
+    }
+    m = std::max(m, sum.cwiseAbs().maxCoeff());
+  }
+  return m;
+}
+
+Objective::Objective(MessSystem& system, const DofMap& map, double force_scale)
+    : system_(system), map_(map), e0_(force_scale * map.length_scale()) {}
+
+double Objective::operator()(const Eigen::VectorXd& u, Eigen::VectorXd& gradient) {
+  map_.to_positions(u, system_.mutable_positions());
+  last_ = system_.evaluate(&gradient_);
+  ++evaluations_;
+  gradient = map_.reduce(gradient_) / e0_;
+  return last_.potential / e0_;
+}
+
+}  // namespace mresim::mess::detail

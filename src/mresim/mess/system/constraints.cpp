@@ -1,0 +1,173 @@
+#include "mresim/mess/system/constraints.hpp"
+
+#include <stdexcept>
+#include <string>
+
+namespace mresim::mess {
+
+BoundaryConstraints BoundaryConstraints::none(std::int64_t node_count) {
+  BoundaryConstraints c;
+  c.fixed.assign(static_cast<std::size_t>(3 * node_count), 0);
+  c.prescribed = Eigen::Matrix3Xd::Zero(3, node_count);
+  return c;
+}
+
+void BoundaryConstraints::fix_nodes(const std::vector<int>& nodes,
+                                    const Eigen::Matrix3Xd& positions) {
+  if (fixed.empty()) *this = none(positions.cols());
+  for (const int n : nodes) {
+    if (n < 0 || n >= prescribed.cols()) {
+      throw std::invalid_argument("BoundaryConstraints::fix_nodes: node " + std::to_string(n) +
+                                  " out of range");
+    }
+    for (int a = 0; a < 3; ++a) fixed[3 * static_cast<std::size_t>(n) + a] = 1;
+    prescribed.col(n) = positions.col(n);
+  }
+}
+
+void BoundaryConstraints::fix_face(const lattice::GridShape& shape, lattice::Face face,
+                                   const Eigen::Matrix3Xd& positions) {
+  fix_nodes(lattice::face_nodes(shape, face), positions);
+}
+
+void BoundaryConstraints::add_rigid_group(std::vector<std::int32_t> nodes) {
+  rigid_groups.push_back(RigidGroup{std::move(nodes)});
+}
+
+void BoundaryConstraints::validate(std::int64_t node_count) const {
+  if (!fixed.empty() && static_cast<std::int64_t>(fixed.size()) != 3 * node_count) {
+    throw std::invalid_argument("BoundaryConstraints: 'fixed' must have 3 entries per node");
+  }
+  if (!fixed.empty() && prescribed.cols() != node_count) {
+    throw std::invalid_argument("BoundaryConstraints: 'prescribed' must have one column per node");
+  }
+  std::vector<std::uint8_t> in_group(static_cast<std::size_t>(node_count), 0);
+  for (std::size_t g = 0; g < rigid_groups.size(); ++g) {
+    if (rigid_groups[g].nodes.empty()) {
+      throw std::invalid_argument("BoundaryConstraints: rigid group " + std::to_string(g) +
+                                  " is empty");
+    }
+    for (const std::int32_t n : rigid_groups[g].nodes) {
+      if (n < 0 || n >= node_count) {
+        throw std::invalid_argument("BoundaryConstraints: rigid group " + std::to_string(g) +
+                                    " has node " + std::to_string(n) + " out of range");
+      }
+      if (in_group[static_cast<std::size_t>(n)]++ != 0) {
+        throw std::invalid_argument("BoundaryConstraints: node " + std::to_string(n) +
+                                    " is in more than one rigid group");
+      }
+      for (int a = 0; a < 3; ++a) {
+        if (is_fixed(n, a)) {
+          throw std::invalid_argument("BoundaryConstraints: node " + std::to_string(n) +
+                                      " of rigid group " + std::to_string(g) +
+                                      " has a held coordinate");
+        }
+      }
+    }
+  }
+}
+
+void BoundaryConstraints::apply(Eigen::Matrix3Xd& x) const {
+  if (fixed.empty()) return;
+  for (Eigen::Index n = 0; n < x.cols(); ++n) {
+    for (int a = 0; a < 3; ++a) {
+      if (fixed[static_cast<std::size_t>(3 * n + a)] != 0) x(a, n) = prescribed(a, n);
+    }
+  }
+}
+
+// ------------------------------------------------------------------------------- DofMap
+
+DofMap::DofMap(const BoundaryConstraints& constraints, const Eigen::Matrix3Xd& reference,
+               double length_scale)
+    : length_scale_(length_scale) {
+  const std::int64_t n_nodes = reference.cols();
+  constraints.validate(n_nodes);
+  std::vector<std::uint8_t> in_group(static_cast<std::size_t>(n_nodes), 0);
+  for (const RigidGroup& g : constraints.rigid_groups) {
+    Eigen::Matrix3Xd ref(3, static_cast<Eigen::Index>(g.nodes.size()));
+    for (std::size_t k = 0; k < g.nodes.size(); ++k) {
+      in_group[static_cast<std::size_t>(g.nodes[k])] = 1;
+      ref.col(static_cast<Eigen::Index>(k)) = reference.col(g.nodes[k]);
+    }
+    group_nodes_.push_back(g.nodes);
+    group_reference_.push_back(std::move(ref));
+  }
+  dof_index_.assign(static_cast<std::size_t>(3 * n_nodes), -1);
+  for (std::int64_t n = 0; n < n_nodes; ++n) {
+    if (in_group[static_cast<std::size_t>(n)] != 0) continue;
+    for (int a = 0; a < 3; ++a) {
+      if (constraints.is_fixed(n, a)) continue;
+      dof_index_[static_cast<std::size_t>(3 * n + a)] =
+          static_cast<Eigen::Index>(coordinates_.size());
+      coordinates_.push_back(3 * n + a);
+    }
+  }
+  const auto nc = static_cast<Eigen::Index>(coordinates_.size());
+  for (std::size_t g = 0; g < group_nodes_.size(); ++g) {
+    for (const std::int32_t n : group_nodes_[g]) {
+      for (int a = 0; a < 3; ++a) {
+        dof_index_[3 * static_cast<std::size_t>(n) + a] = nc + 3 * static_cast<Eigen::Index>(g) + a;
+      }
+    }
+  }
+}
+
+Eigen::VectorXd DofMap::to_dofs(const Eigen::Matrix3Xd& x) const {
+  Eigen::VectorXd u(size());
+  const double inv = 1.0 / length_scale_;
+  const double* data = x.data();
+  const auto nc = static_cast<Eigen::Index>(coordinates_.size());
+  for (Eigen::Index k = 0; k < nc; ++k)
+    u[k] = data[coordinates_[static_cast<std::size_t>(k)]] * inv;
+  for (Eigen::Index g = 0; g < groups(); ++g) {
+    const auto gi = static_cast<std::size_t>(g);
+    u.segment<3>(nc + 3 * g) = (x.col(group_nodes_[gi][0]) - group_reference_[gi].col(0)) * inv;
+  }
+  return u;
+}
+
+void DofMap::to_positions(const Eigen::VectorXd& u, Eigen::Matrix3Xd& x) const {
+  double* data = x.data();
+  const auto nc = static_cast<Eigen::Index>(coordinates_.size());
+  for (Eigen::Index k = 0; k < nc; ++k) {
+    data[coordinates_[static_cast<std::size_t>(k)]] = u[k] * length_scale_;
+  }
+  for (Eigen::Index g = 0; g < groups(); ++g) {
+    const auto gi = static_cast<std::size_t>(g);
+    const Eigen::Vector3d t = u.segment<3>(nc + 3 * g) * length_scale_;
+    for (std::size_t k = 0; k < group_nodes_[gi].size(); ++k) {
+      x.col(group_nodes_[gi][k]) = group_reference_[gi].col(static_cast<Eigen::Index>(k)) + t;
+    }
+  }
+}
+
+Eigen::VectorXd DofMap::reduce(const Eigen::Matrix3Xd& gradient) const {
+  Eigen::VectorXd g(size());
+  const double* data = gradient.data();
+  const auto nc = static_cast<Eigen::Index>(coordinates_.size());
+  for (Eigen::Index k = 0; k < nc; ++k) {
+    g[k] = data[coordinates_[static_cast<std::size_t>(k)]] * length_scale_;
+  }
+  for (Eigen::Index gr = 0; gr < groups(); ++gr) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const std::int32_t n : group_nodes_[static_cast<std::size_t>(gr)]) sum += gradient.col(n);
+    g.segment<3>(nc + 3 * gr) = sum * length_scale_;
+  }
+  return g;
+}
+
+Eigen::VectorXd DofMap::reduce_masses(const Eigen::VectorXd& masses) const {
+  Eigen::VectorXd m(size());
+  const auto nc = static_cast<Eigen::Index>(coordinates_.size());
+  for (Eigen::Index k = 0; k < nc; ++k)
+    m[k] = masses[coordinates_[static_cast<std::size_t>(k)] / 3];
+  for (Eigen::Index gr = 0; gr < groups(); ++gr) {
+    double sum = 0.0;
+    for (const std::int32_t n : group_nodes_[static_cast<std::size_t>(gr)]) sum += masses[n];
+    m.segment<3>(nc + 3 * gr).setConstant(sum);
+  }
+  return m;
+}
+
+}  // namespace mresim::mess

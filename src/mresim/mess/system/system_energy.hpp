@@ -1,0 +1,187 @@
+#pragma once
+
+// The assembled 3D system (Chapter 4, MESS): lattice, profile, magnetic model and applied field,
+// current node positions and particle magnetizations, boundary constraints; its energy broken
+// down by term and its gradient with respect to the node positions (SI units throughout).
+//
+// Energy (Section 4.2.4):
+//   springs  eq. 4.62                      volume  eq. 4.64 x l_e^3 (elastic_terms.hpp)
+//   Zeeman   eq. 4.70                      dipole  eq. 4.71
+//   self     eq. 4.76 (in the total; + mu0 V |M|^2/6 with demagnetization)
+//   self_linearized  eq. 4.73 (reported only, for comparison with the dissertation's plots)
+//   WCA      eq. 4.79                      load    -sum_n f_n . (x_n - x_n^0) (applied forces)
+// total = springs + volume + zeeman + dipole + self + wca + load.
+//
+// Forces. The magnetic terms depend on the particle centres c_p; their gradient with respect to
+// c_p at fixed M (dipole, eq. 4.78, plus WCA, eq. 4.80; Zeeman and self have none in a uniform
+// field) is the total derivative at the self-consistent M by the envelope theorem
+// (docs/magnetization-3d.md). It is shared equally by the particle's n_p nodes (Section 4.2.4,
+// "distributed among all nodes ... to ensure rigid body translation"):
+//   dE/dx_i += (dE/dc_p) / n_p   for every node i of particle p.
+// With CentreRule::all_nodes (physical profile) c_p is the mean of all n_p nodes, so this is the
+// exact gradient. With CentreRule::centre_voxel (seed profile: the original's centre, the mean of
+// the 8 corners of the centre voxel, docs/original-code.md#particles) the spreading is the
+// original's and not the exact gradient of E(c_p(x)); the two centres differ only by the
+// particle's internal deformation (particle springs are 1e4 times stiffer than the polymer's).
+//
+// "Potential" = the function whose gradient the forces are: total + (volume_force_factor - 1)
+// volume, i.e. the total for the physical profile and springs + 4 x volume + ... for the seed
+// profile (docs/original-code.md#volume-elements). The minimisers minimise the potential; every
+// report uses the energies.
+//
+// Magnetization. The magnetizations are part of the state. evaluate() re-solves them
+// (solve_magnetization with the current M as history, the fallback chain of
+// docs/magnetization-3d.md) according to MagnetizationUpdate: before every evaluation (the
+// original's dynamics), only once a particle centre has moved more than resolve_distance l_e
+// since the last solve, or only when asked (solve_magnetization()). Every solve is recorded
+// (MagnetizationStats); an unconverged solve is counted, never hidden.
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+
+#include "mresim/mess/lattice/lattice.hpp"
+#include "mresim/mess/magnetization/self_consistent.hpp"
+#include "mresim/mess/system/constraints.hpp"
+#include "mresim/mess/terms/elastic_terms.hpp"
+#include "mresim/mess/terms/magnetic_energy.hpp"
+
+namespace mresim::mess {
+
+struct ModelProfile;  // profile/model_profile.hpp
+
+// Where a particle's magnetic centre is.
+enum class CentreRule {
+  all_nodes,     // mean of all its nodes: spreading the force evenly is the exact gradient
+  centre_voxel,  // mean of the 8 corners of its centre voxel (the original code)
+};
+
+enum class MagnetizationUpdate {
+  every_evaluation,  // re-solve before every energy/gradient evaluation (the original)
+  on_displacement,   // re-solve when a centre moved more than resolve_distance since the last
+  manual,            // only in solve_magnetization()
+};
+
+struct MessSettings {
+  ElasticTermSettings elastic;
+  CentreRule centre_rule = CentreRule::all_nodes;
+  magnetism::MagnetizationOptions magnetization;  // demagnetization follows the model's flag
+  MagnetizationUpdate magnetization_update = MagnetizationUpdate::every_evaluation;
+  double resolve_distance = 1e-3;  // in units of l_e (on_displacement)
+
+  // Each model profile has its settings: ModelProfile::system_settings().
+};
+
+struct MessEnergies {
+  double springs = 0.0;          // eq. 4.62
+  double volume = 0.0;           // eq. 4.64 x l_e^3, with kappa
+  double zeeman = 0.0;           // eq. 4.70
+  double dipole = 0.0;           // eq. 4.71
+  double self = 0.0;             // eq. 4.76 (consistent; in the total)
+  double self_linearized = 0.0;  // eq. 4.73 (reported only)
+  double wca = 0.0;              // eq. 4.79
+  double load = 0.0;             // work of the applied nodal forces, -sum f.(x - x0)
+  double total() const { return springs + volume + zeeman + dipole + self + wca + load; }
+};
+
+struct Evaluation {
+  MessEnergies energies;
+  double potential = 0.0;  // total + (volume_force_factor - 1) volume
+  // The potential's rounding error is about machine epsilon times this: the sum of the
+  // absolute values of its terms plus the elastic terms' cancellation scales
+  // (ElasticEnergies::springs_rounding, volume_rounding). Used by line searches.
+  double magnitude = 0.0;
+};
+
+struct MagnetizationStats {
+  std::int64_t solves = 0;
+  std::int64_t unconverged = 0;             // solves that missed the tolerance
+  std::int64_t total_iterations = 0;        // over all solves and methods
+  std::array<std::int64_t, 3> by_method{};  // solves ended by fixed_point, anderson, newton
+  magnetism::MagnetizationResult last;      // the latest solve's full diagnostics
+};
+
+class MessSystem {
+ public:
+  // Throws std::invalid_argument if the model's particle radius is not the lattice's or the
+  // settings are invalid. Positions start at the lattice's initial positions, M at zero with
+  // no history (the first solve starts from FK(H_ext)), no constraints, no applied forces.
+  MessSystem(lattice::Lattice lattice, magnetism::MagneticModel model, MessSettings settings);
+
+  // The dissertation's particles (chi0 = 70, Ms = 1.6e6 A/m) with the lattice's radius, WCA
+  // scaled by the profile's Ms, the profile's settings. applied_field is H_ext in A/m.
+  static MessSystem make(lattice::Lattice lattice, const Eigen::Vector3d& applied_field,
+                         const ModelProfile& profile,
+                         const magnetism::MagneticParticles& particles = {});
+
+  const lattice::Lattice& lattice() const { return lattice_; }
+  const magnetism::MagneticModel& model() const { return model_; }
+  const MessSettings& settings() const { return settings_; }
+  MessSettings& settings() { return settings_; }
+  std::int64_t node_count() const { return lattice_.node_count(); }
+  std::size_t particle_count() const { return lattice_.particle_count(); }
+  double length_scale() const { return lattice_.element_length; }
+
+  // H_ext (A/m). The next evaluation re-solves M (unless the update is manual).
+  void set_applied_field(const Eigen::Vector3d& applied_field);
+
+  const Eigen::Matrix3Xd& positions() const { return positions_; }
+  // All node positions (m); the held coordinates are then written from the constraints.
+  void set_positions(const Eigen::Matrix3Xd& positions);
+  // Mutable access for solvers; call apply_constraints() if held coordinates may have changed.
+  Eigen::Matrix3Xd& mutable_positions() { return positions_; }
+
+  const BoundaryConstraints& constraints() const { return constraints_; }
+  // Validates, stores and applies (held coordinates are written into the positions).
+  void set_constraints(BoundaryConstraints constraints);
+  void apply_constraints() { constraints_.apply(positions_); }
+
+  // Applied nodal forces (N, 3 x N; an empty matrix removes them). Their potential energy,
+  // -sum f.(x - x0) with x0 the lattice's initial positions, is the 'load' term.
+  void set_applied_forces(const Eigen::Matrix3Xd& forces);
+  const Eigen::Matrix3Xd& applied_forces() const { return applied_forces_; }
+
+  const Eigen::Matrix3Xd& magnetizations() const { return M_; }
+  // Sets M (A/m, 3 x N_p) as the history for the next solve.
+  void set_magnetizations(const Eigen::Matrix3Xd& M);
+  bool has_magnetization_history() const { return has_history_; }
+
+  // Particle centres under the settings' CentreRule (m, 3 x N_p).
+  Eigen::Matrix3Xd particle_centres() const;
+  // Either rule, e.g. to compare (or the bounding-box midpoint the original's analysis uses).
+  Eigen::Matrix3Xd particle_centres(CentreRule rule) const;
+  Eigen::Matrix3Xd particle_bounding_box_centres() const;
+
+  // Re-solves M now at the current positions from the current M (history).
+  const magnetism::MagnetizationResult& solve_magnetization();
+  const MagnetizationStats& magnetization_stats() const { return stats_; }
+
+  // Energies at the current positions and M (no re-solve).
+  MessEnergies energies() const;
+  // Re-solves M per the update rule, then energies, potential and (if not null) the gradient
+  // of the potential with respect to every node coordinate (J/m, 3 x N; held coordinates are
+  // not zeroed, see BoundaryConstraints / DofMap).
+  Evaluation evaluate(Eigen::Matrix3Xd* gradient);
+  // Gradient of the magnetic terms with respect to the particle centres at the current M
+  // (J/m, 3 x N_p): dipole + WCA.
+  Eigen::Matrix3Xd centre_gradient() const;
+
+ private:
+  void maybe_update_magnetization();
+  MessEnergies magnetic_and_load_energies(const Eigen::Matrix3Xd& centres) const;
+
+  lattice::Lattice lattice_;
+  magnetism::MagneticModel model_;  // self_energy forced to consistent (4.76)
+  MessSettings settings_;
+  ElasticTerms elastic_;
+  Eigen::Matrix3Xd positions_;
+  BoundaryConstraints constraints_;
+  Eigen::Matrix3Xd applied_forces_;
+  Eigen::Matrix3Xd M_;
+  bool has_history_ = false;
+  bool field_changed_ = true;
+  Eigen::Matrix3Xd last_solve_centres_;
+  MagnetizationStats stats_;
+};
+
+}  // namespace mresim::mess

@@ -1,0 +1,91 @@
+// The output directory of a 3D run (docs/outputs-3d.md): results.h5 datasets and their sizes,
+// summary.csv, and the XDMF view of the deformed lattice (cells in VTK hexahedron order, one
+// positions file per step), read back without the writer's code.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+
+#include "../../support/hdf5_read.hpp"
+#include "../../support/temp_dir.hpp"
+#include "../support/small_runs.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using mresim::testing::Hdf5Reader;
+using mresim::testing::read_text;
+using mresim::testing::TempDir;
+
+TEST(MessOutputs, ResultsSummaryAndXdmfAreConsistent) {
+  const TempDir dir;
+  std::string toml = mresim::mess_protocol::testing::small_hysteresis(0.1, 1);
+  toml += "node_positions = true\n";  // appended to [output]
+  std::ofstream(dir / "run.toml") << toml;
+  const std::string command = "cd '" + dir.path().string() + "' && '" + MRESIM_CLI_PATH +
+                              "' run run.toml --out out --no-plot -j 2 >/dev/null 2>&1";
+  const int raw = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0);
+
+  const fs::path out = dir / "out";
+  const std::size_t steps = 6;  // loop over 0, 0.1 T: 5 x 1 + 1
+  const Hdf5Reader h5(out / "results.h5");
+  EXPECT_EQ(h5.doubles("/steps/energies/total").size(), steps);
+  EXPECT_EQ(h5.shape("/steps/centres"), (std::vector<hsize_t>{steps, 2, 3}));
+  EXPECT_EQ(h5.shape("/steps/cluster_id"), (std::vector<hsize_t>{steps, 2}));
+  EXPECT_EQ(h5.strings("/steps/solver/status").size(), steps);
+  // The energy terms add up to the total (self_linearized is reported only).
+  const auto total = h5.doubles("/steps/energies/total");
+  for (std::size_t s = 0; s < steps; ++s) {
+    double sum = 0.0;
+    for (const char* t : {"springs", "volume", "zeeman", "dipole", "self", "wca", "load"}) {
+      sum += h5.doubles(std::string("/steps/energies/") + t)[s];
+    }
+    EXPECT_NEAR(sum, total[s], 1e-12 * std::abs(total[s]) + 1e-30);
+  }
+
+  // summary.csv: header plus one row per step.
+  const std::string csv = read_text(out / "summary.csv");
+  EXPECT_EQ(static_cast<std::size_t>(std::count(csv.begin(), csv.end(), '\n')), steps + 1);
+
+  // XDMF: one grid per step, each geometry file present with N x 3 positions.
+  const std::string xdmf = read_text(out / "mess.xdmf");
+  std::size_t grids = 0;
+  for (std::size_t pos = 0; (pos = xdmf.find("GridType=\"Uniform\"", pos)) != std::string::npos;
+       ++pos) {
+    ++grids;
+  }
+  EXPECT_EQ(grids, steps);
+  const auto nodes = static_cast<hsize_t>(h5.ints("/lattice/particle_id").size());
+  const auto cells = h5.shape("/lattice/cells");
+  ASSERT_EQ(cells.size(), 2U);
+  EXPECT_EQ(cells[1], 8U);
+  EXPECT_NE(xdmf.find("NumberOfElements=\"" + std::to_string(cells[0]) + "\""), std::string::npos);
+  for (std::size_t s = 0; s < steps; ++s) {
+    char name[32];
+    std::snprintf(name, sizeof name, "step_%06zu.h5", s);
+    EXPECT_NE(xdmf.find(std::string("positions/") + name), std::string::npos) << name;
+    const Hdf5Reader p(out / "positions" / name);
+    EXPECT_EQ(p.shape("/positions"), (std::vector<hsize_t>{nodes, 3}));
+  }
+  // VTK hexahedron order: from vertex 0, vertex 1 is +x, vertex 3 is +y, vertex 4 is +z.
+  const auto c = h5.ints("/lattice/cells");
+  const auto x0 = h5.doubles("/lattice/initial_positions");
+  const auto at = [&](std::int64_t node, int axis) {
+    return x0[static_cast<std::size_t>(3 * node + axis)];
+  };
+  const double le = 1e-6;
+  EXPECT_NEAR(at(c[1], 0) - at(c[0], 0), le, 1e-15);
+  EXPECT_NEAR(at(c[3], 1) - at(c[0], 1), le, 1e-15);
+  EXPECT_NEAR(at(c[4], 2) - at(c[0], 2), le, 1e-15);
+  EXPECT_NEAR(at(c[6], 0) - at(c[0], 0), le, 1e-15);
+  EXPECT_NEAR(at(c[6], 1) - at(c[0], 1), le, 1e-15);
+  EXPECT_NEAR(at(c[6], 2) - at(c[0], 2), le, 1e-15);
+}
+
+}  // namespace
