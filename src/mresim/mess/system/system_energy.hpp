@@ -43,34 +43,13 @@
 #include "mresim/mess/lattice/lattice.hpp"
 #include "mresim/mess/magnetization/self_consistent.hpp"
 #include "mresim/mess/system/constraints.hpp"
+#include "mresim/mess/system/mess_settings.hpp"
 #include "mresim/mess/terms/elastic_terms.hpp"
 #include "mresim/mess/terms/magnetic_energy.hpp"
 
 namespace mresim::mess {
 
 struct ModelProfile;  // profile/model_profile.hpp
-
-// Where a particle's magnetic centre is.
-enum class CentreRule {
-  all_nodes,     // mean of all its nodes: spreading the force evenly is the exact gradient
-  centre_voxel,  // mean of the 8 corners of its centre voxel (the original code)
-};
-
-enum class MagnetizationUpdate {
-  every_evaluation,  // re-solve before every energy/gradient evaluation (the original)
-  on_displacement,   // re-solve when a centre moved more than resolve_distance since the last
-  manual,            // only in solve_magnetization()
-};
-
-struct MessSettings {
-  ElasticTermSettings elastic;
-  CentreRule centre_rule = CentreRule::all_nodes;
-  magnetism::MagnetizationOptions magnetization;  // demagnetization follows the model's flag
-  MagnetizationUpdate magnetization_update = MagnetizationUpdate::every_evaluation;
-  double resolve_distance = 1e-3;  // in units of l_e (on_displacement)
-
-  // Each model profile has its settings: ModelProfile::system_settings().
-};
 
 struct MessEnergies {
   double springs = 0.0;          // eq. 4.62
