@@ -148,6 +148,44 @@ std::string one_line(std::string_view text) {
   return out;
 }
 
+[[noreturn]] void fail_at(const std::string& key_path, const toml::node& node,
+                          std::string_view what_is_allowed) {
+  throw ConfigError(fmt::format("{} = {}: {}", key_path, format_node(node), what_is_allowed));
+}
+
+// A finite TOML integer or float inside `range`; `key_path` names it ("field.values[1][0]").
+double number_at(const toml::node& node, const std::string& key_path, Range range,
+                 std::string_view unit) {
+  double value = 0.0;
+  if (const auto* i = node.as_integer()) {
+    value = static_cast<double>(i->get());
+  } else if (const auto* f = node.as_floating_point()) {
+    value = f->get();
+  } else {
+    fail_at(key_path, node, fmt::format("expected a number{}", unit_suffix(unit)));
+  }
+  if (!std::isfinite(value)) {
+    fail_at(key_path, node, fmt::format("expected a finite number{}", unit_suffix(unit)));
+  }
+  if (!range.contains(value)) {
+    fail_at(key_path, node, fmt::format("{}{}", range.describe(), unit_suffix(unit)));
+  }
+  return value;
+}
+
+std::array<double, 3> vector3_at(const toml::node& node, const std::string& key_path, Range range,
+                                 std::string_view unit) {
+  const auto* array = node.as_array();
+  if (array == nullptr || array->size() != 3) {
+    fail_at(key_path, node, fmt::format("expected [x, y, z]{}", unit_suffix(unit)));
+  }
+  std::array<double, 3> v{};
+  for (std::size_t a = 0; a < 3; ++a) {
+    v.at(a) = number_at(*array->get(a), fmt::format("{}[{}]", key_path, a), range, unit);
+  }
+  return v;
+}
+
 }  // namespace
 
 TableReader::TableReader(std::shared_ptr<detail::Document> doc, const void* table, std::string path)
@@ -252,33 +290,10 @@ void TableReader::fail_missing(std::string_view key, std::string_view kind,
   throw ConfigError(message);
 }
 
-double TableReader::to_number(const void* node_ptr, const std::string& key_path, Range range,
-                              std::string_view unit) const {
-  const toml::node& node = *as_node(node_ptr);
-  double value = 0.0;
-  if (const auto* i = node.as_integer()) {
-    value = static_cast<double>(i->get());
-  } else if (const auto* f = node.as_floating_point()) {
-    value = f->get();
-  } else {
-    throw ConfigError(fmt::format("{} = {}: expected a number{}", key_path, format_node(node),
-                                  unit_suffix(unit)));
-  }
-  if (!std::isfinite(value)) {
-    throw ConfigError(fmt::format("{} = {}: expected a finite number{}", key_path,
-                                  format_node(node), unit_suffix(unit)));
-  }
-  if (!range.contains(value)) {
-    throw ConfigError(fmt::format("{} = {}: {}{}", key_path, format_node(node), range.describe(),
-                                  unit_suffix(unit)));
-  }
-  return value;
-}
-
 double TableReader::number(std::string_view key, Range range, std::string_view unit) const {
   const void* node = lookup(key);
   if (node == nullptr) fail_missing(key, "key", unit_suffix(unit));
-  return to_number(node, path(key), range, unit);
+  return number_at(*as_node(node), path(key), range, unit);
 }
 
 double TableReader::number_or(std::string_view key, double fallback, Range range,
@@ -290,7 +305,7 @@ std::optional<double> TableReader::optional_number(std::string_view key, Range r
                                                    std::string_view unit) const {
   const void* node = lookup(key);
   if (node == nullptr) return std::nullopt;
-  return to_number(node, path(key), range, unit);
+  return number_at(*as_node(node), path(key), range, unit);
 }
 
 long TableReader::integer(std::string_view key, Range range) const {
@@ -380,9 +395,84 @@ std::optional<std::vector<double>> TableReader::optional_number_list(std::string
   std::vector<double> values;
   values.reserve(array->size());
   for (std::size_t i = 0; i < array->size(); ++i) {
-    values.push_back(to_number(array->get(i), fmt::format("{}[{}]", path(key), i), range, unit));
+    values.push_back(number_at(*array->get(i), fmt::format("{}[{}]", path(key), i), range, unit));
   }
   return values;
+}
+
+std::optional<std::array<double, 3>> TableReader::optional_vector3(std::string_view key,
+                                                                   Range range,
+                                                                   std::string_view unit) const {
+  const void* node_ptr = lookup(key);
+  if (node_ptr == nullptr) return std::nullopt;
+  return vector3_at(*as_node(node_ptr), path(key), range, unit);
+}
+
+std::optional<std::vector<std::array<double, 3>>> TableReader::optional_vector3_list(
+    std::string_view key, Range range, std::string_view unit, std::size_t min_size) const {
+  const void* node_ptr = lookup(key);
+  if (node_ptr == nullptr) return std::nullopt;
+  const toml::node& node = *as_node(node_ptr);
+  const std::string key_path = path(key);
+  const auto* array = node.as_array();
+  if (array == nullptr) {
+    fail_at(key_path, node,
+            fmt::format("expected a list of [x, y, z] vectors{}", unit_suffix(unit)));
+  }
+  if (array->size() < min_size) {
+    fail_at(key_path, node,
+            fmt::format("expected at least {} [x, y, z] vector{}{}", min_size,
+                        min_size == 1 ? "" : "s", unit_suffix(unit)));
+  }
+  std::vector<std::array<double, 3>> vectors;
+  vectors.reserve(array->size());
+  for (std::size_t i = 0; i < array->size(); ++i) {
+    vectors.push_back(vector3_at(*array->get(i), fmt::format("{}[{}]", key_path, i), range, unit));
+  }
+  return vectors;
+}
+
+std::optional<std::array<long, 3>> TableReader::optional_integer3(std::string_view key,
+                                                                  Range range) const {
+  const void* node_ptr = lookup(key);
+  if (node_ptr == nullptr) return std::nullopt;
+  const toml::node& node = *as_node(node_ptr);
+  const std::string key_path = path(key);
+  const auto* array = node.as_array();
+  if (array == nullptr || array->size() != 3) {
+    fail_at(key_path, node, "expected three integers [x, y, z]");
+  }
+  std::array<long, 3> values{};
+  for (std::size_t a = 0; a < 3; ++a) {
+    const toml::node& item = *array->get(a);
+    const std::string item_path = fmt::format("{}[{}]", key_path, a);
+    const auto* i = item.as_integer();
+    if (i == nullptr) fail_at(item_path, item, "expected an integer");
+    const auto value = static_cast<long>(i->get());
+    if (!range.contains(static_cast<double>(value))) fail_at(item_path, item, range.describe());
+    values.at(a) = value;
+  }
+  return values;
+}
+
+bool TableReader::is_array(std::string_view key) const {
+  const toml::node* node = as_table(table_).get(key);
+  return node != nullptr && node->is_array();
+}
+
+std::optional<std::size_t> TableReader::choice_index(std::string_view key,
+                                                     const std::vector<std::string>& names,
+                                                     bool required) const {
+  if (!required && !has(key)) {
+    (void)lookup(key);
+    return std::nullopt;
+  }
+  const std::string name = choice(key, names);
+  return static_cast<std::size_t>(std::find(names.begin(), names.end(), name) - names.begin());
+}
+
+std::string vector_text(const std::array<double, 3>& v) {
+  return fmt::format("[{}, {}, {}]", format_float(v[0]), format_float(v[1]), format_float(v[2]));
 }
 
 TableReader TableReader::table(std::string_view key) const {

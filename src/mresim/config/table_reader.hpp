@@ -1,11 +1,17 @@
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <filesystem>
+#include <initializer_list>
+#include <iterator>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <string_view>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "mresim/config/config_error.hpp"
@@ -64,6 +70,42 @@ class TableReader {
   [[nodiscard]] std::optional<std::vector<double>> optional_number_list(
       std::string_view key, Range range, std::string_view unit, std::size_t min_size = 1) const;
 
+  // [x, y, z]: exactly three finite numbers, each inside `range`:
+  // "box.size = [1, 2]: expected [x, y, z] (m)", "box.size[1] = -2: must be > 0 (m)".
+  // Absent: nullopt (callers say what a missing vector means in their own message).
+  [[nodiscard]] std::optional<std::array<double, 3>> optional_vector3(std::string_view key,
+                                                                      Range range,
+                                                                      std::string_view unit) const;
+  // [[x, y, z], ...] with at least `min_size` vectors, every component inside `range`:
+  // "field.values[1] = [0.1, 0]: expected [x, y, z] (T)", "field.values[0][2] = ...".
+  [[nodiscard]] std::optional<std::vector<std::array<double, 3>>> optional_vector3_list(
+      std::string_view key, Range range, std::string_view unit, std::size_t min_size = 1) const;
+  // [a, b, c]: exactly three TOML integers (2.0 is rejected), each inside `range`:
+  // "particles.count_per_axis[1] = \"1\": expected an integer".
+  [[nodiscard]] std::optional<std::array<long, 3>> optional_integer3(std::string_view key,
+                                                                     Range range) const;
+  // Whether `key` holds an array of any kind (false if absent), for keys that accept a scalar or
+  // a vector. Like has(), does not mark the key as known.
+  [[nodiscard]] bool is_array(std::string_view key) const;
+
+  // A string naming one of a fixed set of values, returned as the value paired with the name:
+  //   t.enumeration_or("sequence", Sequence::up, {{"loop", Sequence::loop}, {"up", Sequence::up}})
+  // Messages are choice()'s, naming the options in the order given:
+  // 'field.sequence = "lop": must be one of loop, up'.
+  template <class E>
+  using Options = std::initializer_list<std::pair<std::string_view, E>>;
+  template <class E>
+  [[nodiscard]] E enumeration(std::string_view key,
+                              Options<std::type_identity_t<E>> options) const {
+    return value_at(options, choice_index(key, names_of(options), true));
+  }
+  template <class E>
+  [[nodiscard]] E enumeration_or(std::string_view key, E fallback,
+                                 Options<std::type_identity_t<E>> options) const {
+    const auto index = choice_index(key, names_of(options), false);
+    return index ? value_at(options, index) : fallback;
+  }
+
   // Whether the key is present (any type). Does not mark the key as known.
   [[nodiscard]] bool has(std::string_view key) const;
 
@@ -110,8 +152,26 @@ class TableReader {
   [[noreturn]] void fail_missing(std::string_view key, std::string_view kind,
                                  std::string_view detail) const;
   [[nodiscard]] std::string misspelling_hint_for(std::string_view key, bool table) const;
-  [[nodiscard]] double to_number(const void* node, const std::string& path, Range range,
-                                 std::string_view unit) const;
+  // The position of the value of `key` in `names` (messages as choice()); nullopt when the key
+  // is absent and not `required`.
+  [[nodiscard]] std::optional<std::size_t> choice_index(std::string_view key,
+                                                        const std::vector<std::string>& names,
+                                                        bool required) const;
+
+  template <class E>
+  static std::vector<std::string> names_of(Options<E> options) {
+    std::vector<std::string> names;
+    names.reserve(options.size());
+    for (const auto& option : options) names.emplace_back(option.first);
+    return names;
+  }
+  template <class E>
+  static E value_at(Options<E> options, std::optional<std::size_t> index) {
+    if (!index || *index >= options.size()) {
+      throw std::logic_error("TableReader::enumeration: no option at this index");
+    }
+    return std::next(options.begin(), static_cast<std::ptrdiff_t>(*index))->second;
+  }
 
   std::shared_ptr<detail::Document> doc_;
   // The toml::table this reader looks at. Kept opaque so that this header (included by every
@@ -119,5 +179,9 @@ class TableReader {
   const void* table_;
   std::string path_;
 };
+
+// "[6e-06, 6e-06, 1.5e-05]": the numbers of a vector as the reader writes numbers in its
+// messages (shortest round-trip text, floats kept recognisable as floats: "[0.0, 1.0, 2.5]").
+[[nodiscard]] std::string vector_text(const std::array<double, 3>& v);
 
 }  // namespace mresim::config
