@@ -12,7 +12,6 @@
 
 #include "mresim/core/constants.hpp"
 #include "mresim/mess/lattice/stiffness.hpp"
-#include "mresim/mess/run_file/array_reader.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
 
 namespace mresim::mess_config {
@@ -25,8 +24,6 @@ namespace {
 
 constexpr double kDegree = std::numbers::pi / 180.0;
 
-const std::vector<std::string> kAxes{"x", "y", "z"};
-
 const std::vector<std::string> kPlacements{"regular",
                                            "regular_noisy",
                                            "regular_anisotropic",
@@ -37,8 +34,23 @@ const std::vector<std::string> kPlacements{"regular",
                                            "chain",
                                            "helix"};
 
+const std::vector<std::string> kAxes{"x", "y", "z"};
+
 int axis_index(const std::string& name) {
   return static_cast<int>(std::find(kAxes.begin(), kAxes.end(), name) - kAxes.begin());
+}
+
+// The table reader returns vectors as plain arrays (config/ does not depend on Eigen).
+Eigen::Vector3d to_vector(const std::array<double, 3>& v) { return {v[0], v[1], v[2]}; }
+std::optional<Eigen::Vector3d> to_vector(const std::optional<std::array<double, 3>>& v) {
+  if (!v) return std::nullopt;
+  return to_vector(*v);
+}
+std::vector<Eigen::Vector3d> to_vectors(const std::vector<std::array<double, 3>>& list) {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(list.size());
+  for (const auto& v : list) out.push_back(to_vector(v));
+  return out;
 }
 
 std::string quoted(std::string_view s) { return fmt::format("\"{}\"", s); }
@@ -116,9 +128,8 @@ void reject_foreign_keys(const TableReader& t, const std::string& placement,
 }
 
 std::array<double, 3> read_anisotropy(const TableReader& t) {
-  if (is_array(t, "anisotropy_factor")) {
-    const auto f = optional_vector3(t, "anisotropy_factor", Range::positive(), "");
-    return {(*f)[0], (*f)[1], (*f)[2]};
+  if (t.is_array("anisotropy_factor")) {
+    return *t.optional_vector3("anisotropy_factor", Range::positive(), "");
   }
   const auto f = t.optional_number("anisotropy_factor", Range::positive(), "");
   if (!f) {
@@ -132,15 +143,12 @@ std::array<double, 3> read_anisotropy(const TableReader& t) {
 lattice::BoxSpec read_box(const TableReader& root, const mess::ModelProfile& profile) {
   const TableReader box = root.table("box");
   lattice::BoxSpec b;
-  const auto size = optional_vector3(box, "size", Range::positive(), "m");
+  const auto size = box.optional_vector3("size", Range::positive(), "m");
   if (!size) missing(box, "size", "[Lx, Ly, Lz], m");
-  b.lengths = *size;
-  const std::string fallback = profile.default_box_rounding == lattice::BoxRounding::nearest
-                                   ? "nearest"
-                                   : "seed_floor_divide";
-  b.rounding = box.choice_or("rounding", fallback, {"nearest", "seed_floor_divide"}) == "nearest"
-                   ? lattice::BoxRounding::nearest
-                   : lattice::BoxRounding::seed_floor_divide;
+  b.lengths = to_vector(*size);
+  b.rounding = box.enumeration_or("rounding", profile.default_box_rounding,
+                                  {{"nearest", lattice::BoxRounding::nearest},
+                                   {"seed_floor_divide", lattice::BoxRounding::seed_floor_divide}});
   return b;
 }
 
@@ -169,7 +177,7 @@ void read_placement(const TableReader& root, const TableReader& t, MessSpec& s) 
     }
     lattice::RegularPlacement r;
     r.volume_fraction = t.number("volume_fraction", Range::open(0.0, 1.0), "");
-    const auto counts = optional_integer3(t, "count_per_axis", Range::between(1, 10000));
+    const auto counts = t.optional_integer3("count_per_axis", Range::between(1, 10000));
     if (!counts) missing(t, "count_per_axis", "[nx, ny, nz], particles along x, y and z");
     for (int a = 0; a < 3; ++a) r.particles_along_axes[a] = static_cast<int>((*counts)[a]);
     r.anisotropic = anisotropic;
@@ -187,9 +195,9 @@ void read_placement(const TableReader& root, const TableReader& t, MessSpec& s) 
     reject_foreign_keys(t, name, {"positions"});
     lattice::ByHandPlacement h;
     h.box = read_box(root, *s.profile);
-    const auto positions = optional_vector3_list(t, "positions", Range::any(), "m", 1);
+    const auto positions = t.optional_vector3_list("positions", Range::any(), "m", 1);
     if (!positions) missing(t, "positions", "[[x, y, z], ...], particle centres in m");
-    h.positions = *positions;
+    h.positions = to_vectors(*positions);
     s.box = h.box;
     s.lattice.placement = h;
   } else if (kind == Kind::chain) {
@@ -198,8 +206,8 @@ void read_placement(const TableReader& root, const TableReader& t, MessSpec& s) 
     c.box = read_box(root, *s.profile);
     c.count = static_cast<int>(t.integer_or("count", 2, Range::between(1, 100000)));
     c.separation = t.number("separation", Range::positive(), "m");
-    c.axis = axis_index(t.choice_or("axis", "z", kAxes));
-    c.centre = optional_vector3(t, "centre", Range::any(), "m");
+    c.axis = t.enumeration_or("axis", 2, {{"x", 0}, {"y", 1}, {"z", 2}});
+    c.centre = to_vector(t.optional_vector3("centre", Range::any(), "m"));
     s.box = c.box;
     s.lattice.placement = c;
   } else {
@@ -211,7 +219,7 @@ void read_placement(const TableReader& root, const TableReader& t, MessSpec& s) 
     h.radius = t.number("helix_radius", Range::non_negative(), "m");
     h.axial_separation = t.number_or("axial_separation", 5.0e-6, Range::any(), "m");
     h.angle_step = kDegree * t.number_or("angle_step", 45.0, Range::any(), "deg");
-    h.centre = optional_vector3(t, "centre", Range::any(), "m");
+    h.centre = to_vector(t.optional_vector3("centre", Range::any(), "m"));
     s.box = h.box;
     s.lattice.placement = h;
   }
@@ -303,7 +311,9 @@ void derive_checked(const TableReader& root, const TableReader& t, MessSpec& s) 
         const auto p = particle_named_in(message);
         const auto& positions = std::get<lattice::ByHandPlacement>(s.lattice.placement).positions;
         if (p && *p < positions.size()) {
-          t.fail(fmt::format("positions[{}]", *p), vector_text(positions[*p]), message);
+          t.fail(fmt::format("positions[{}]", *p),
+                 config::vector_text({positions[*p][0], positions[*p][1], positions[*p][2]}),
+                 message);
         }
         t.fail("positions", t.value_text("positions"), message);
       }
@@ -404,10 +414,9 @@ void read_particles(const TableReader& root, MessSpec& s) {
   p.Ms = t.number_or("saturation_magnetization", 1.6e6, Range::positive(), "A/m");
   p.chi0 = t.number_or("susceptibility", 70.0, Range::positive(), "");
   s.demagnetization = t.boolean_or("demagnetization", false);
-  s.self_energy =
-      t.choice_or("self_energy", "consistent", {"consistent", "linearized"}) == "consistent"
-          ? magnetism::SelfEnergyForm::consistent
-          : magnetism::SelfEnergyForm::linearized;
+  s.self_energy = t.enumeration_or("self_energy", magnetism::SelfEnergyForm::consistent,
+                                   {{"consistent", magnetism::SelfEnergyForm::consistent},
+                                    {"linearized", magnetism::SelfEnergyForm::linearized}});
   s.lattice.iron_density =
       t.number_or("density", lattice::kIronDensity, Range::positive(), "kg/m^3");
   s.lattice.particle_radius = p.radius;
@@ -429,11 +438,13 @@ void read_field(const TableReader& root, MessRunType type, FieldSpec& f) {
   const auto max = t.optional_number("max", Range::positive(), "T");
   const long steps = t.integer_or("steps", 0, Range::between(1, 100000));
   const auto magnitudes = t.optional_number_list("magnitudes", Range::non_negative(), "T", 1);
-  const auto values = optional_vector3_list(t, "values", Range::any(), "T", 1);
+  const auto values = t.optional_vector3_list("values", Range::any(), "T", 1);
   const auto theta = t.optional_number("theta", Range::between(0.0, 180.0), "deg");
   const auto phi = t.optional_number("phi", Range::between(-360.0, 360.0), "deg");
-  const std::string fallback_sequence = type == MessRunType::hysteresis ? "loop" : "up";
-  const std::string sequence = t.choice_or("sequence", fallback_sequence, {"loop", "up"});
+  const FieldSequence default_sequence =
+      type == MessRunType::hysteresis ? FieldSequence::loop : FieldSequence::up;
+  const FieldSequence sequence = t.enumeration_or(
+      "sequence", default_sequence, {{"loop", FieldSequence::loop}, {"up", FieldSequence::up}});
 
   std::vector<std::string> forms;
   if (has_max || has_steps) forms.emplace_back(has_max ? "max" : "steps");
@@ -468,14 +479,14 @@ void read_field(const TableReader& root, MessRunType type, FieldSpec& f) {
              "field.magnitudes");
     }
     f.form = FieldSpec::Form::vectors;
-    f.values = *values;
+    f.values = to_vectors(*values);
     for (const auto& b : f.values) f.max = std::max(f.max, b.norm());
     return;
   }
 
   f.theta_deg = theta.value_or(0.0);
   f.phi_deg = phi.value_or(0.0);
-  f.sequence = sequence == "loop" ? FieldSequence::loop : FieldSequence::up;
+  f.sequence = sequence;
   if (has_max || has_steps) {
     if (!has_steps) {
       needed(t, "steps",
