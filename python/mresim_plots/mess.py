@@ -31,8 +31,10 @@ from matplotlib.patches import Circle
 
 from .common import BRANCH_LINESTYLE, MAG_LABEL, PlotError, case_colors
 
-# (dataset under /steps/energies, panel title); `self_linearized` (eq. 4.73, reported only) is
-# drawn dashed in the self-energy panel, not in a panel of its own.
+# The energy terms are the system's list (src/mresim/mess/terms/energy_term.hpp): results.h5
+# lists them in /steps/energies@terms and gives each dataset its `title` and `equation`.
+# `self_linearized` (eq. 4.73, reported only) is drawn dashed in the self-energy panel, not in a
+# panel of its own. For files without those attributes: the built-in terms and their titles.
 ENERGY_PANELS = [
     ("springs", "springs (eq. 4.62)"),
     ("volume", "volume elements (eq. 4.64)"),
@@ -104,9 +106,18 @@ class MessData:
             # The fit's strain axis (docs/outputs-3d.md); files without it: the applied load.
             self.strain = _array(s, "measured_strain", self.load_value)
             self.energies = {}
+            self.energy_titles = {}
+            self.energy_order = []
             if "energies" in s:
                 for name, dataset in s["energies"].items():
                     self.energies[name] = np.asarray(dataset[()], dtype=float)
+                    if "title" in dataset.attrs:
+                        title = _text(dataset.attrs["title"])
+                        equation = _text(dataset.attrs.get("equation", ""))
+                        self.energy_titles[name] = (f"{title} ({equation})"
+                                                    if equation.startswith("eq.") else title)
+                if "terms" in s["energies"].attrs:
+                    self.energy_order = _text(s["energies"].attrs["terms"]).split(",")
             self.energy_density = _array(s, "energy_density", None)
             self.separation = _array(s, "separation", None)
             self.m_along = _array(s, "magnetization_projection", None)
@@ -297,10 +308,21 @@ def separation_magnetization(run, data):
 
 # ---------------------------------------------------------------- energies
 
+def energy_panels(data):
+    """(dataset, panel title) in the system's term order, then the total."""
+    fallback = dict(ENERGY_PANELS)
+    order = data.energy_order or [name for name, _ in ENERGY_PANELS if name != "total"]
+    panels = [(name, data.energy_titles.get(name, fallback.get(name, name))) for name in order
+              if name in data.energies and name != "self_linearized"]
+    if "total" in data.energies:
+        panels.append(("total", "total"))
+    return panels
+
+
 def energies(run, data):
     """Energies by term (J): against B for field sweeps, against the strain per field for
     strain and stress runs (Fig. 4.14a-f)."""
-    panels = [(name, title) for name, title in ENERGY_PANELS if name in data.energies]
+    panels = energy_panels(data)
     if not panels:
         return
     ncols = 4 if len(panels) > 6 else 3

@@ -15,6 +15,13 @@ NODES = (9, 7, 13)  # per axis: an 8 x 6 x 12 um box
 MS = 1.6e6
 ENERGY_TERMS = ["springs", "volume", "zeeman", "dipole", "self", "self_linearized", "wca",
                 "load"]
+# (title, equation) attributes as the C++ code writes them (src/mresim/mess/terms/*.cpp).
+ENERGY_LABELS = {
+    "springs": ("springs", "eq. 4.62"), "volume": ("volume elements", "eq. 4.64"),
+    "zeeman": ("Zeeman", "eq. 4.70"), "dipole": ("dipole-dipole", "eq. 4.71"),
+    "self": ("magnetic self", "eq. 4.76"), "self_linearized": ("magnetic self, linearized", "eq. 4.73"),
+    "wca": ("WCA", "eq. 4.79"), "load": ("applied load", "-sum f.(x - x0)"),
+}
 
 
 def lattice():
@@ -96,6 +103,9 @@ def write_run(directory, run_type, field, field_index, load_index, load_value, l
         shares = [0.3, 0.25, -0.6, -0.2, 0.15, 0.12, 0.02, 0.0]
         for i, (name, share) in enumerate(zip(ENERGY_TERMS, shares)):
             s[f"energies/{name}"] = share * total + 1e-18 * np.sin(np.arange(steps) + i)
+            s[f"energies/{name}"].attrs["title"], s[f"energies/{name}"].attrs["equation"] = \
+                ENERGY_LABELS[name]
+        s["energies"].attrs["terms"] = ",".join(ENERGY_TERMS)
         s["energies/total"] = total
         s["system_volume"] = np.full(steps, volume)
         s["energy_density"] = energy_density

@@ -57,7 +57,7 @@ void write_checkpoint(const fs::path& file, const ProtocolState& state,
     }
     if (!state.records.empty()) {
       write_step_records(out, "/records", state.records, runner.system().particle_count(),
-                         load_unit(runner.spec()));
+                         load_unit(runner.spec()), *runner.system().energy_labels());
     }
     out.close();
   }
@@ -93,7 +93,8 @@ ProtocolState read_checkpoint(const fs::path& file, const ProtocolRunner& runner
   }
   if (next > 0) {
     state.records =
-        read_step_records(in, "/records", runner.steps(), runner.system().particle_count());
+        read_step_records(in, "/records", runner.steps(), runner.system().particle_count(),
+                          runner.system().energy_labels());
   }
   if (state.records.size() != next) {
     throw std::runtime_error("checkpoint " + file.string() + ": records do not match next_step");

@@ -228,12 +228,12 @@ void write_analysis(const fs::path& run_dir, io::Hdf5File& results, const Protoc
 
 void write_summary(const fs::path& run_dir, const std::vector<StepRecord>& records,
                    const StepExtras& x, const std::vector<std::int64_t>& valid,
-                   const char* load_unit) {
+                   const char* load_unit, const mess::TermLabels& terms) {
   std::vector<std::string> columns = {
       "step",           "field_index", "load_index", "Bx_T",
       "By_T",           "Bz_T",        "B_along_T",  std::string("load_") + load_unit,
       "measured_strain"};
-  for (const EnergyTerm& t : energy_terms()) columns.push_back(std::string("E_") + t.name + "_J");
+  for (const mess::TermLabel& t : terms) columns.push_back("E_" + t.name + "_J");
   for (const char* c :
        {"E_total_J", "energy_density_J_m3", "system_volume_m3", "M_along_Ms", "min_separation_m",
         "clusters", "converged", "valid", "iterations", "max_force_N", "wall_time_s"}) {
@@ -251,7 +251,7 @@ void write_summary(const fs::path& run_dir, const std::vector<StepRecord>& recor
                                x.field_projection[i],
                                r.step.load_value,
                                r.measured_strain};
-    for (const EnergyTerm& t : energy_terms()) row.push_back(r.energies.*(t.member));
+    for (const mess::TermLabel& t : terms) row.push_back(energy_or_nan(r.energies, t.name));
     row.insert(row.end(), {r.energies.total(), x.energy_density[i], r.system_volume,
                            x.magnetization_projection[i], x.separation[i],
                            static_cast<double>(x.cluster_count[i]), r.converged ? 1.0 : 0.0,
@@ -323,8 +323,8 @@ std::string step_place(const mc::MessSpec& spec, const StepRecord& r) {
 std::string non_finite_quantities(const StepRecord& r) {
   std::vector<std::string> bad;
   bool energy = std::isfinite(r.energies.total());
-  for (const EnergyTerm& t : energy_terms())
-    energy = energy && std::isfinite(r.energies.*(t.member));
+  for (std::size_t k = 0; k < r.energies.size(); ++k)
+    energy = energy && std::isfinite(r.energies.value(k));
   if (!energy) bad.emplace_back("energy");
   if (!std::isfinite(r.system_volume)) bad.emplace_back("system volume");
   if (!std::isfinite(r.measured_strain)) bad.emplace_back("measured strain");
@@ -368,7 +368,7 @@ std::vector<std::int64_t> check_steps(const mc::MessSpec& spec,
 
 std::vector<StepRecord> with_nan_for_non_finite(std::vector<StepRecord> records) {
   for (StepRecord& r : records) {
-    for (const EnergyTerm& t : energy_terms()) nan_if_not_finite(r.energies.*(t.member));
+    for (std::size_t k = 0; k < r.energies.size(); ++k) nan_if_not_finite(r.energies.value(k));
     nan_if_not_finite(r.system_volume);
     nan_if_not_finite(r.measured_strain);
     nan_if_not_finite(r.max_force);
@@ -390,7 +390,7 @@ MessResultCheck write_mess_results(const fs::path& run_dir, io::Hdf5File& result
   const std::vector<StepRecord> records = with_nan_for_non_finite(computed);
   write_lattice(results, runner);
   const std::size_t np = runner.system().particle_count();
-  write_step_records(results, "/steps", records, np, unit);
+  write_step_records(results, "/steps", records, np, unit, *runner.system().energy_labels());
   results.write_int_vector("/steps/valid", valid);
   const StepExtras x = step_extras(runner, records);
   const Eigen::Vector3d d = field_direction(spec);
@@ -402,7 +402,7 @@ MessResultCheck write_mess_results(const fs::path& run_dir, io::Hdf5File& result
   results.write_int_vector("/steps/cluster_count", x.cluster_count);
   results.write_int_vector("/steps/largest_cluster", x.largest_cluster);
   results.write_int_array("/steps/cluster_id", {records.size(), np}, x.cluster_id);
-  write_summary(run_dir, records, x, valid, unit);
+  write_summary(run_dir, records, x, valid, unit, *runner.system().energy_labels());
   if (spec.strain || spec.stress) write_analysis(run_dir, results, runner, records, x, check);
   if (spec.output.node_positions) write_xdmf(run_dir, runner, records);
   return check;

@@ -1,21 +1,12 @@
 #include "mresim/mess/outputs/step_records_io.hpp"
 
+#include <limits>
 #include <stdexcept>
 
 namespace mresim::mess_protocol {
 
-const std::vector<EnergyTerm>& energy_terms() {
-  static const std::vector<EnergyTerm> terms = {
-      {"springs", &mess::MessEnergies::springs},
-      {"volume", &mess::MessEnergies::volume},
-      {"zeeman", &mess::MessEnergies::zeeman},
-      {"dipole", &mess::MessEnergies::dipole},
-      {"self", &mess::MessEnergies::self},
-      {"self_linearized", &mess::MessEnergies::self_linearized},
-      {"wca", &mess::MessEnergies::wca},
-      {"load", &mess::MessEnergies::load},
-  };
-  return terms;
+double energy_or_nan(const mess::MessEnergies& energies, std::string_view name) {
+  return energies.has(name) ? energies[name] : std::numeric_limits<double>::quiet_NaN();
 }
 
 void write_columns(io::Hdf5File& file, const std::string& path, const Eigen::Matrix3Xd& m,
@@ -67,7 +58,7 @@ std::vector<double> stacked(const std::vector<StepRecord>& records,
 
 void write_step_records(io::Hdf5File& file, const std::string& group,
                         const std::vector<StepRecord>& records, std::size_t particle_count,
-                        const char* load_unit) {
+                        const char* load_unit, const mess::TermLabels& terms) {
   const std::string g = group + "/";
   file.create_group(group);
   file.write_int_vector(g + "index", int_column(records, [](auto& r) { return r.step.index; }));
@@ -81,10 +72,17 @@ void write_step_records(io::Hdf5File& file, const std::string& group,
                         int_column(records, [](auto& r) { return r.step.load_index; }));
   file.write_vector(g + "load_value", column(records, [](auto& r) { return r.step.load_value; }),
                     load_unit);
-  for (const EnergyTerm& t : energy_terms()) {
-    file.write_vector(g + "energies/" + t.name,
-                      column(records, [&](auto& r) { return r.energies.*(t.member); }), "J");
+  for (const mess::TermLabel& t : terms) {
+    const std::string path = g + "energies/" + t.name;
+    file.write_vector(
+        path, column(records, [&](auto& r) { return energy_or_nan(r.energies, t.name); }), "J");
+    file.write_string_attribute(path, "equation", t.equation);
+    file.write_string_attribute(path, "title", t.title);
   }
+  // The list order (HDF5 lists a group's members by name).
+  std::string order;
+  for (const mess::TermLabel& t : terms) order += (order.empty() ? "" : ",") + t.name;
+  if (!terms.empty()) file.write_string_attribute(g + "energies", "terms", order);
   file.write_vector(g + "energies/total",
                     column(records, [](auto& r) { return r.energies.total(); }), "J");
   file.write_vector(g + "system_volume", column(records, [](auto& r) { return r.system_volume; }),
@@ -124,7 +122,8 @@ void write_step_records(io::Hdf5File& file, const std::string& group,
 
 std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std::string& group,
                                           const std::vector<StepSpec>& steps,
-                                          std::size_t particle_count) {
+                                          std::size_t particle_count,
+                                          const std::shared_ptr<const mess::TermLabels>& terms) {
   const std::string g = group + "/";
   const std::vector<std::int64_t> index = file.ints(g + "index");
   const std::size_t n = index.size();
@@ -145,9 +144,10 @@ std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std:
     }
     records[i].step = steps[static_cast<std::size_t>(index[i])];
   }
-  for (const EnergyTerm& t : energy_terms()) {
-    const std::vector<double> v = doubles(g + "energies/" + t.name);
-    for (std::size_t i = 0; i < n; ++i) records[i].energies.*(t.member) = v[i];
+  for (StepRecord& r : records) r.energies = mess::MessEnergies(terms);
+  for (std::size_t k = 0; k < (terms ? terms->size() : 0); ++k) {
+    const std::vector<double> v = doubles(g + "energies/" + (*terms)[k].name);
+    for (std::size_t i = 0; i < n; ++i) records[i].energies.value(k) = v[i];
   }
   const std::vector<double> volume = doubles(g + "system_volume");
   const std::vector<double> strain = doubles(g + "measured_strain");

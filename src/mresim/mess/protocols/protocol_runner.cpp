@@ -29,7 +29,7 @@ mess::MessSystem make_system(const mc::MessSpec& spec) {
   mess::MessSettings settings = spec.profile->system_settings();
   settings.magnetization = spec.solver.magnetization;
   settings.magnetization.demagnetization = spec.demagnetization;
-  return {std::move(lat), std::move(model), settings};
+  return {std::move(lat), std::move(model), settings, spec.terms};
 }
 
 // The load of one step; `reference` as loading.hpp describes.

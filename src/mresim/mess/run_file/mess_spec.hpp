@@ -30,6 +30,7 @@
 #include "mresim/mess/magnetization/magnetic_particles.hpp"
 #include "mresim/mess/magnetization/self_consistent.hpp"
 #include "mresim/mess/profile/model_profile.hpp"
+#include "mresim/mess/terms/energy_term.hpp"
 #include "mresim/mess/terms/magnetic_energy.hpp"
 
 namespace mresim::mess_config {
@@ -237,6 +238,10 @@ struct MessSpec {
   // regular placement), one line each without "mresim: warning: "; the run type prints them and
   // records them in results.h5 /@warnings.
   std::vector<std::string> warnings;
+
+  // The optional energy terms chosen by [terms.<name>] tables (mess::read_term_tables), for
+  // the system (MessSystem's constructor).
+  std::vector<mess::TermSpec> terms;
 
   // Load values (strain or stress; 1 for the other run types).
   std::size_t load_step_count() const;

@@ -997,6 +997,9 @@ MessSpec read_mess_spec(const TableReader& root, std::string_view run_type) {
               fmt::format("only read by [run] type = \"mess_stress\" (this is {})", this_type));
   }
 
+  // The optional energy terms' tables [terms.<name>] (terms/energy_term.hpp).
+  s.terms = mess::read_term_tables(root);
+
   read_solver(root.optional_table("solver"), s.demagnetization, s.solver);
   check_scales(root, s);
   check_leapfrog(root.optional_table("solver"), s);

@@ -1,6 +1,7 @@
 #include "mresim/mess/system/system_energy.hpp"
 
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -11,8 +12,12 @@ namespace mresim::mess {
 
 namespace mm = mresim::magnetism;
 
-MessSystem::MessSystem(lattice::Lattice lattice, mm::MagneticModel model, MessSettings settings)
-    : lattice_(std::move(lattice)), model_(std::move(model)), settings_(std::move(settings)) {
+MessSystem::MessSystem(lattice::Lattice lattice, mm::MagneticModel model, MessSettings settings,
+                       std::vector<TermSpec> terms)
+    : lattice_(std::move(lattice)),
+      model_(std::move(model)),
+      settings_(std::move(settings)),
+      term_specs_(std::move(terms)) {
   model_.particles.validate();
   if (lattice_.particle_count() > 0 &&
       std::abs(model_.particles.radius - lattice_.particle_radius) >
@@ -31,18 +36,50 @@ MessSystem::MessSystem(lattice::Lattice lattice, mm::MagneticModel model, MessSe
   model_.self_energy = mm::SelfEnergyForm::consistent;  // eq. 4.76 in the total (envelope)
   settings_.magnetization.demagnetization = model_.demagnetization;
   settings_.magnetization.validate();
-  elastic_ = ElasticTerms(lattice_, settings_.elastic);
+  build_terms();
   positions_ = lattice_.positions;
   constraints_ = BoundaryConstraints::none(lattice_.node_count());
   M_ = Eigen::Matrix3Xd::Zero(3, static_cast<Eigen::Index>(lattice_.particle_count()));
 }
 
+MessSystem::MessSystem(const MessSystem& other)
+    : lattice_(other.lattice_),
+      model_(other.model_),
+      settings_(other.settings_),
+      term_specs_(other.term_specs_),
+      positions_(other.positions_),
+      constraints_(other.constraints_),
+      applied_forces_(other.applied_forces_),
+      M_(other.M_),
+      has_history_(other.has_history_),
+      field_changed_(other.field_changed_),
+      last_solve_centres_(other.last_solve_centres_),
+      stats_(other.stats_) {
+  build_terms();
+}
+
+MessSystem& MessSystem::operator=(const MessSystem& other) {
+  if (this != &other) *this = MessSystem(other);
+  return *this;
+}
+
+void MessSystem::build_terms() {
+  terms_ = make_energy_terms({lattice_, model_, settings_}, term_specs_);
+  auto labels = std::make_shared<TermLabels>();
+  for (const auto& t : terms_) {
+    labels->push_back({std::string(t->name()), std::string(t->equation()), std::string(t->title()),
+                       t->in_total()});
+  }
+  labels_ = std::move(labels);
+}
+
 MessSystem MessSystem::make(lattice::Lattice lattice, const Eigen::Vector3d& applied_field,
-                            const ModelProfile& profile, const mm::MagneticParticles& particles) {
+                            const ModelProfile& profile, const mm::MagneticParticles& particles,
+                            std::vector<TermSpec> terms) {
   mm::MagneticParticles p = particles;
   p.radius = lattice.particle_radius > 0.0 ? lattice.particle_radius : p.radius;
   mm::MagneticModel model = mm::MagneticModel::make(p, applied_field, profile.wca_scale_ms(p.Ms));
-  return {std::move(lattice), std::move(model), profile.system_settings()};
+  return {std::move(lattice), std::move(model), profile.system_settings(), std::move(terms)};
 }
 
 void MessSystem::set_applied_field(const Eigen::Vector3d& applied_field) {
@@ -164,72 +201,132 @@ void MessSystem::maybe_update_magnetization() {
   }
 }
 
-MessEnergies MessSystem::magnetic_and_load_energies(const Eigen::Matrix3Xd& centres) const {
-  MessEnergies e;
-  if (centres.cols() > 0) {
-    const mm::MagneticEnergyBreakdown b = mm::magnetic_energies(model_, centres, M_);
-    e.zeeman = b.zeeman;
-    e.dipole = b.dipole;
-    e.self = b.self;
-    e.wca = b.wca;
-    mm::MagneticModel linearized = model_;
-    linearized.self_energy = mm::SelfEnergyForm::linearized;
-    e.self_linearized = mm::self_energy(linearized, centres, M_);
-  }
-  if (applied_forces_.cols() > 0) {
-    const Eigen::Matrix3Xd& x0 = lattice_.positions;
-    e.load = -detail::fixed_order_sum(lattice_.node_count(), [&](std::int64_t n) {
-      return applied_forces_.col(n).dot(positions_.col(n) - x0.col(n));
-    });
-  }
-  return e;
+template <class F>
+auto MessSystem::with_state(F&& f) const {
+  const Eigen::Matrix3Xd centres = particle_centres();
+  // One pair list for all pair terms (dipole, WCA), as magnetic_energies() builds it.
+  const mm::PairList pairs =
+      centres.cols() > 0 ? mm::OpenBoundary{}.pairs(centres) : mm::PairList{};
+  const TermState state{lattice_, positions_,      centres,   M_,
+                        model_,   applied_forces_, settings_, pairs};
+  return f(state);
 }
 
 MessEnergies MessSystem::energies() const {
-  MessEnergies e = magnetic_and_load_energies(particle_centres());
-  const ElasticEnergies el = elastic_.evaluate(lattice_, positions_, nullptr);
-  e.springs = el.springs;
-  e.volume = el.volume;
-  return e;
+  return with_state([&](const TermState& state) {
+    MessEnergies e(labels_);
+    for (std::size_t i = 0; i < terms_.size(); ++i) {
+      e.value(i) = terms_[i]->evaluate(state, nullptr).energy;
+    }
+    return e;
+  });
 }
 
 Eigen::Matrix3Xd MessSystem::centre_gradient() const {
-  const Eigen::Matrix3Xd centres = particle_centres();
-  if (centres.cols() == 0) return Eigen::Matrix3Xd::Zero(3, 0);
-  return mm::magnetic_gradient(model_, centres, M_);
+  return with_state([&](const TermState& state) {
+    TermGradient g = TermGradient::zero(state);
+    for (const auto& t : terms_) {
+      if (t->in_total()) (void)t->evaluate(state, &g);
+    }
+    return Eigen::Matrix3Xd(g.centres);
+  });
 }
+
+namespace {
+
+// Adds dE/dc_p / n_p to every node of particle p (the rule of the header).
+void spread_centre_terms(const lattice::Lattice& lat, const Eigen::Matrix3Xd& gc,
+                         Eigen::Matrix3Xd& nodes) {
+  for (Eigen::Index p = 0; p < gc.cols(); ++p) {
+    const auto& members = lat.particle_nodes[static_cast<std::size_t>(p)];
+    const Eigen::Vector3d share = gc.col(p) / static_cast<double>(members.size());
+    for (const std::int32_t n : members) nodes.col(n) += share;
+  }
+}
+
+}  // namespace
 
 Evaluation MessSystem::evaluate(Eigen::Matrix3Xd* gradient) {
   if (!(settings_.elastic.volume_force_factor > 0.0)) {
     throw std::invalid_argument("MessSystem: volume_force_factor must be > 0");
   }
-  elastic_.set_settings(settings_.elastic);  // settings() may have been edited
   maybe_update_magnetization();
-  const Eigen::Matrix3Xd centres = particle_centres();
-  Evaluation out;
-  out.energies = magnetic_and_load_energies(centres);
-  const ElasticEnergies el = elastic_.evaluate(lattice_, positions_, gradient);
-  out.energies.springs = el.springs;
-  out.energies.volume = el.volume;
-  const MessEnergies& e = out.energies;
-  const double factor = settings_.elastic.volume_force_factor;
-  out.potential = e.total() + (factor - 1.0) * e.volume;
-  out.magnitude = el.springs_rounding + factor * el.volume_rounding + std::abs(e.springs) +
-                  factor * std::abs(e.volume) + std::abs(e.zeeman) + std::abs(e.dipole) +
-                  std::abs(e.self) + std::abs(e.wca) + std::abs(e.load);
-  if (gradient == nullptr) return out;
-
-  if (applied_forces_.cols() > 0) *gradient -= applied_forces_;
-  if (centres.cols() > 0) {
-    // Dipole (eq. 4.78) + WCA (eq. 4.80) at fixed M, shared equally by the particle's nodes.
-    const Eigen::Matrix3Xd gc = mm::magnetic_gradient(model_, centres, M_);
-    for (Eigen::Index p = 0; p < centres.cols(); ++p) {
-      const auto& nodes = lattice_.particle_nodes[static_cast<std::size_t>(p)];
-      const Eigen::Vector3d share = gc.col(p) / static_cast<double>(nodes.size());
-      for (const std::int32_t n : nodes) gradient->col(n) += share;
+  return with_state([&](const TermState& state) {
+    Evaluation out;
+    out.energies = MessEnergies(labels_);
+    TermGradient g;
+    if (gradient != nullptr) {
+      g.nodes = std::move(*gradient);  // reuse the caller's storage
+      g.nodes.setZero(3, lattice_.node_count());
+      g.centres.setZero(3, state.centres.cols());
     }
+    // The magnitude is one sum in list order: first every rounding scale, then every |E|,
+    // each times its force factor (the order of the fixed fields before the term list).
+    double magnitude = 0.0;
+    double extra = 0.0;  // sum (force_factor - 1) E over the terms whose factor is not 1
+    std::vector<double> factors(terms_.size(), 0.0);
+    for (std::size_t i = 0; i < terms_.size(); ++i) {
+      const EnergyTerm& t = *terms_[i];
+      const bool counted = t.in_total();
+      const TermValue v = t.evaluate(state, counted && gradient != nullptr ? &g : nullptr);
+      out.energies.value(i) = v.energy;
+      if (!counted) continue;
+      factors[i] = t.force_factor(state);
+      magnitude += factors[i] * v.rounding;
+      // Never (1 - 1) x inf: the self-energy may be +inf.
+      if (factors[i] != 1.0) extra += (factors[i] - 1.0) * v.energy;
+    }
+    for (std::size_t i = 0; i < terms_.size(); ++i) {
+      if (terms_[i]->in_total()) magnitude += factors[i] * std::abs(out.energies.value(i));
+    }
+    out.potential = extra == 0.0 ? out.energies.total() : out.energies.total() + extra;
+    out.magnitude = magnitude;
+    if (gradient != nullptr) {
+      spread_centre_terms(lattice_, g.centres, g.nodes);
+      *gradient = std::move(g.nodes);
+    }
+    return out;
+  });
+}
+
+Eigen::Matrix3Xd MessSystem::hessian_product(const Eigen::Matrix3Xd& v) const {
+  if (v.cols() != lattice_.node_count()) {
+    throw std::invalid_argument("MessSystem::hessian_product: expected " +
+                                std::to_string(lattice_.node_count()) + " columns");
   }
-  return out;
+  return with_state([&](const TermState& state) {
+    // The centres' direction under the centre rule (the first 8 nodes: the centre voxel).
+    TermGradient direction{v, Eigen::Matrix3Xd::Zero(3, state.centres.cols())};
+    for (Eigen::Index p = 0; p < state.centres.cols(); ++p) {
+      const auto& nodes = lattice_.particle_nodes[static_cast<std::size_t>(p)];
+      const std::size_t count =
+          settings_.centre_rule == CentreRule::centre_voxel ? 8 : nodes.size();
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (std::size_t k = 0; k < count; ++k) sum += v.col(nodes[k]);
+      direction.centres.col(p) = sum / static_cast<double>(count);
+    }
+    TermGradient out = TermGradient::zero(state);
+    for (const auto& t : terms_) {
+      if (t->in_total() && t->hessian_kind() != HessianKind::zero) {
+        t->add_hessian_product(state, direction, out);
+      }
+    }
+    spread_centre_terms(lattice_, out.centres, out.nodes);
+    return Eigen::Matrix3Xd(out.nodes);
+  });
+}
+
+Eigen::SparseMatrix<double> MessSystem::elastic_hessian() const {
+  return with_state([&](const TermState& state) {
+    std::vector<Eigen::Triplet<double>> entries;
+    for (const auto& t : terms_) {
+      if (t->in_total() && t->has_hessian_entries()) t->add_hessian_entries(state, entries);
+    }
+    const Eigen::Index n = 3 * lattice_.node_count();
+    Eigen::SparseMatrix<double> h(n, n);
+    h.setFromTriplets(entries.begin(), entries.end());
+    return h;
+  });
 }
 
 }  // namespace mresim::mess

@@ -4,13 +4,15 @@
 // current node positions and particle magnetizations, boundary constraints; its energy broken
 // down by term and its gradient with respect to the node positions (SI units throughout).
 //
-// Energy (Section 4.2.4):
+// Energy (Section 4.2.4): a list of energy terms (terms/energy_term.hpp), in registry order;
+// the built-in ones, always present, are
 //   springs  eq. 4.62                      volume  eq. 4.64 x l_e^3 (elastic_terms.hpp)
 //   Zeeman   eq. 4.70                      dipole  eq. 4.71
 //   self     eq. 4.76 (in the total; + mu0 V |M|^2/6 with demagnetization)
 //   self_linearized  eq. 4.73 (reported only, for comparison with the dissertation's plots)
 //   WCA      eq. 4.79                      load    -sum_n f_n . (x_n - x_n^0) (applied forces)
-// total = springs + volume + zeeman + dipole + self + wca + load.
+// total = springs + volume + zeeman + dipole + self + wca + load, plus the optional terms the
+// run file chose ([terms.<name>] tables).
 //
 // Forces. The magnetic terms depend on the particle centres c_p; their gradient with respect to
 // c_p at fixed M (dipole, eq. 4.78, plus WCA, eq. 4.80; Zeeman and self have none in a uniform
@@ -24,10 +26,11 @@
 // original's and not the exact gradient of E(c_p(x)); the two centres differ only by the
 // particle's internal deformation (particle springs are 1e4 times stiffer than the polymer's).
 //
-// "Potential" = the function whose gradient the forces are: total + (volume_force_factor - 1)
-// volume, i.e. the total for the physical profile and springs + 4 x volume + ... for the seed
-// profile (docs/original-code.md#volume-elements). The minimisers minimise the potential; every
-// report uses the energies.
+// "Potential" = the function whose gradient the forces are: total + sum over the terms of
+// (force_factor - 1) E_t, i.e. total + (volume_force_factor - 1) volume, the total for the physical
+// profile and springs + 4 x volume + ... for the seed profile
+// (docs/original-code.md#volume-elements). The minimisers minimise the potential; every report uses
+// the energies.
 //
 // Magnetization. The magnetizations are part of the state. evaluate() re-solves them
 // (solve_magnetization with the current M as history, the fallback chain of
@@ -37,38 +40,29 @@
 // (MagnetizationStats); an unconverged solve is counted, never hidden.
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <array>
 #include <cstdint>
+#include <memory>
+#include <vector>
 
 #include "mresim/mess/lattice/lattice.hpp"
 #include "mresim/mess/magnetization/self_consistent.hpp"
 #include "mresim/mess/system/constraints.hpp"
+#include "mresim/mess/system/mess_energies.hpp"
 #include "mresim/mess/system/mess_settings.hpp"
-#include "mresim/mess/terms/elastic_terms.hpp"
-#include "mresim/mess/terms/magnetic_energy.hpp"
+#include "mresim/mess/terms/energy_term.hpp"
 
 namespace mresim::mess {
 
 struct ModelProfile;  // profile/model_profile.hpp
 
-struct MessEnergies {
-  double springs = 0.0;          // eq. 4.62
-  double volume = 0.0;           // eq. 4.64 x l_e^3, with kappa
-  double zeeman = 0.0;           // eq. 4.70
-  double dipole = 0.0;           // eq. 4.71
-  double self = 0.0;             // eq. 4.76 (consistent; in the total)
-  double self_linearized = 0.0;  // eq. 4.73 (reported only)
-  double wca = 0.0;              // eq. 4.79
-  double load = 0.0;             // work of the applied nodal forces, -sum f.(x - x0)
-  double total() const { return springs + volume + zeeman + dipole + self + wca + load; }
-};
-
 struct Evaluation {
   MessEnergies energies;
-  double potential = 0.0;  // total + (volume_force_factor - 1) volume
+  double potential = 0.0;  // total + sum_t (force_factor_t - 1) E_t
   // The potential's rounding error is about machine epsilon times this: the sum of the
-  // absolute values of its terms plus the elastic terms' cancellation scales
-  // (ElasticEnergies::springs_rounding, volume_rounding). Used by line searches.
+  // absolute values of its terms plus the terms' cancellation scales (TermValue::rounding),
+  // each times its force factor. Used by line searches.
   double magnitude = 0.0;
 };
 
@@ -85,13 +79,28 @@ class MessSystem {
   // Throws std::invalid_argument if the model's particle radius is not the lattice's or the
   // settings are invalid. Positions start at the lattice's initial positions, M at zero with
   // no history (the first solve starts from FK(H_ext)), no constraints, no applied forces.
-  MessSystem(lattice::Lattice lattice, magnetism::MagneticModel model, MessSettings settings);
+  // `terms`: the optional energy terms (run file [terms.<name>], read_term_tables()); the
+  // always-present ones are added by the registry.
+  MessSystem(lattice::Lattice lattice, magnetism::MagneticModel model, MessSettings settings,
+             std::vector<TermSpec> terms = {});
+  // Copies rebuild their terms (terms keep scratch arrays that copies must not share).
+  MessSystem(const MessSystem& other);
+  MessSystem& operator=(const MessSystem& other);
+  MessSystem(MessSystem&&) noexcept = default;
+  MessSystem& operator=(MessSystem&&) noexcept = default;
+  ~MessSystem() = default;
 
   // The dissertation's particles (chi0 = 70, Ms = 1.6e6 A/m) with the lattice's radius, WCA
   // scaled by the profile's Ms, the profile's settings. applied_field is H_ext in A/m.
   static MessSystem make(lattice::Lattice lattice, const Eigen::Vector3d& applied_field,
                          const ModelProfile& profile,
-                         const magnetism::MagneticParticles& particles = {});
+                         const magnetism::MagneticParticles& particles = {},
+                         std::vector<TermSpec> terms = {});
+
+  // The energy terms, in list order, and their labels (every MessEnergies of this system
+  // shares them).
+  const std::vector<std::unique_ptr<EnergyTerm>>& terms() const { return terms_; }
+  const std::shared_ptr<const TermLabels>& energy_labels() const { return labels_; }
 
   const lattice::Lattice& lattice() const { return lattice_; }
   const magnetism::MagneticModel& model() const { return model_; }
@@ -141,18 +150,38 @@ class MessSystem {
   // of the potential with respect to every node coordinate (J/m, 3 x N; held coordinates are
   // not zeroed, see BoundaryConstraints / DofMap).
   Evaluation evaluate(Eigen::Matrix3Xd* gradient);
-  // Gradient of the magnetic terms with respect to the particle centres at the current M
-  // (J/m, 3 x N_p): dipole + WCA.
+  // Gradient of the terms with respect to the particle centres at the current M (J/m,
+  // 3 x N_p): dipole + WCA for the built-in terms.
   Eigen::Matrix3Xd centre_gradient() const;
+
+  // Hessian-vector products and the sparse elastic Hessian, at the current positions and M
+  // (no re-solve), for Newton-type solvers. Both are of the potential, at fixed M.
+  //
+  // H v for a node direction v (3 x N, m): the elastic terms exactly; the centre terms with
+  // the centre rule: v_c = the mean of v over the nodes that define c_p, and the product
+  // (dE/dc)' v_c spread as 1/n_p to each of the particle's nodes, i.e. the derivative of
+  // evaluate()'s gradient at fixed M. (With CentreRule::centre_voxel that map is not
+  // symmetric, as the gradient is not exact; see above.) Bitwise independent of the thread
+  // count for the elastic terms and WCA; the dipole term uses central differences
+  // (terms/magnetic_terms.cpp).
+  Eigen::Matrix3Xd hessian_product(const Eigen::Matrix3Xd& v) const;
+  // The Hessian of the terms that have sparse entries (springs and volume, times their force
+  // factors), 3N x 3N with row/column 3 n + a; held coordinates are not removed.
+  Eigen::SparseMatrix<double> elastic_hessian() const;
 
  private:
   void maybe_update_magnetization();
-  MessEnergies magnetic_and_load_energies(const Eigen::Matrix3Xd& centres) const;
+  void build_terms();
+  // Runs f(state) with the state at the current positions, centres and M.
+  template <class F>
+  auto with_state(F&& f) const;
 
   lattice::Lattice lattice_;
   magnetism::MagneticModel model_;  // self_energy forced to consistent (4.76)
   MessSettings settings_;
-  ElasticTerms elastic_;
+  std::vector<TermSpec> term_specs_;
+  std::vector<std::unique_ptr<EnergyTerm>> terms_;
+  std::shared_ptr<const TermLabels> labels_;
   Eigen::Matrix3Xd positions_;
   BoundaryConstraints constraints_;
   Eigen::Matrix3Xd applied_forces_;

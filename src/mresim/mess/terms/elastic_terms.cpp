@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "mresim/mess/lattice/volume_elements.hpp"
 #include "mresim/mess/system/fixed_order.hpp"
@@ -90,14 +91,44 @@ void add_volume_gradient(const std::vector<std::array<std::int32_t, 8>>& element
   }
 }
 
-// ------------------------------------------------------------------------- ElasticTerms
+// ------------------------------------------------------------------------- SpringKernel
 
-ElasticTerms::ElasticTerms(const lattice::Lattice& lat, ElasticTermSettings settings)
-    : settings_(settings), node_count_(lat.node_count()) {
+namespace {
+
+constexpr std::size_t kIncidenceLimitSprings = std::size_t{1} << 30;  // 2 s + 1 fits int32
+constexpr std::size_t kIncidenceLimitCells = std::size_t{1} << 28;    // 8 c + 7 fits int32
+
+// Runs body(i) for i < n, in parallel for large n; each i writes only its own scratch slot.
+template <class Body>
+void for_each_item(std::int64_t n, Body&& body) {
+#pragma omp parallel for schedule(static) if (n >= detail::kParallelMinimum)
+  for (std::int64_t i = 0; i < n; ++i) body(i);
+}
+
+// The spring's Hessian block B = k [(1 - L/l) I + (L/l) r^ r^T].
+Eigen::Matrix3d spring_block(const lattice::SpringSet& sp, std::size_t s,
+                             const Eigen::Matrix3Xd& x) {
+  const Eigen::Vector3d r = x.col(sp.second[s]) - x.col(sp.first[s]);
+  const double l = r.norm();
+  const double ratio = sp.rest_length(s) / l;
+  const Eigen::Vector3d u = r / l;
+  return sp.stiffness[s] *
+         ((1.0 - ratio) * Eigen::Matrix3d::Identity() + ratio * u * u.transpose());
+}
+
+void check_shapes(const char* who, std::int64_t node_count, const lattice::Lattice& lat,
+                  const Eigen::Matrix3Xd& x) {
+  if (x.cols() != node_count || lat.node_count() != node_count) {
+    throw std::invalid_argument(std::string(who) + ": positions do not match the lattice");
+  }
+}
+
+}  // namespace
+
+SpringKernel::SpringKernel(const lattice::Lattice& lat) : node_count_(lat.node_count()) {
   const lattice::SpringSet& sp = lat.springs;
-  // Incidence entries are int32: 2 s + 1 and 8 c + 7 must fit.
-  if (sp.size() >= (std::size_t{1} << 30) || lat.elements.size() >= (std::size_t{1} << 28)) {
-    throw std::invalid_argument("ElasticTerms: too many springs or cells for 32-bit incidence");
+  if (sp.size() >= kIncidenceLimitSprings) {
+    throw std::invalid_argument("ElasticTerms: too many springs for 32-bit incidence");
   }
   build_incidence(
       node_count_, static_cast<std::int64_t>(sp.size()), 2,
@@ -105,53 +136,169 @@ ElasticTerms::ElasticTerms(const lattice::Lattice& lat, ElasticTermSettings sett
         return k == 0 ? sp.first[static_cast<std::size_t>(s)]
                       : sp.second[static_cast<std::size_t>(s)];
       },
-      spring_offsets_, spring_entries_);
-  build_incidence(
-      node_count_, static_cast<std::int64_t>(lat.elements.size()), 8,
-      [&](std::int64_t c, int v) { return lat.elements[static_cast<std::size_t>(c)][v]; },
-      cell_offsets_, cell_entries_);
+      offsets_, entries_);
 }
 
-ElasticEnergies ElasticTerms::evaluate(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
-                                       Eigen::Matrix3Xd* gradient) const {
-  if (x.cols() != node_count_ || lat.node_count() != node_count_) {
-    throw std::invalid_argument("ElasticTerms::evaluate: positions do not match the lattice");
-  }
+ElasticValue SpringKernel::evaluate(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
+                                    Eigen::Matrix3Xd* gradient) const {
+  check_shapes("SpringKernel::evaluate", node_count_, lat, x);
   const lattice::SpringSet& sp = lat.springs;
   const auto springs = static_cast<std::int64_t>(sp.size());
+  const bool want_gradient = gradient != nullptr;
+  if (want_gradient) scratch_.resize(static_cast<std::size_t>(springs));
+  // Energy (eq. 4.62) and tension k (l - L)/l (eq. 4.63).
+  const auto sums = detail::fixed_order_sums(springs, [&](std::int64_t s) {
+    const auto u = static_cast<std::size_t>(s);
+    const double l = (x.col(sp.second[u]) - x.col(sp.first[u])).norm();
+    const double stretch = l - sp.rest_length(u);
+    if (want_gradient) scratch_[u] = sp.stiffness[u] * stretch / l;
+    const double k_stretch = sp.stiffness[u] * stretch;
+    return std::array<double, 2>{0.5 * k_stretch * stretch, std::abs(k_stretch) * l};
+  });
+  if (!want_gradient) return {sums[0], sums[1]};
+    // Gather: every node sums its own springs in a fixed order (no races, no atomics).
+#pragma omp parallel for schedule(static) if (node_count_ >= detail::kParallelMinimum / 4)
+  for (std::int64_t n = 0; n < node_count_; ++n) {
+    Eigen::Vector3d g = gradient->col(n);
+    for (std::int64_t k = offsets_[n]; k < offsets_[n + 1]; ++k) {
+      const std::int32_t entry = entries_[static_cast<std::size_t>(k)];
+      const auto s = static_cast<std::size_t>(entry >> 1);
+      const Eigen::Vector3d r = x.col(sp.second[s]) - x.col(sp.first[s]);
+      if (entry & 1) {
+        g += scratch_[s] * r;
+      } else {
+        g -= scratch_[s] * r;
+      }
+    }
+    gradient->col(n) = g;
+  }
+  return {sums[0], sums[1]};
+}
+
+void SpringKernel::add_hessian_product(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
+                                       const Eigen::Matrix3Xd& v, Eigen::Matrix3Xd& out) const {
+  check_shapes("SpringKernel::add_hessian_product", node_count_, lat, x);
+  const lattice::SpringSet& sp = lat.springs;
+  scratch_.resize(3 * sp.size());
+  // w_s = B_s (v_j - v_i): +w_s on the second end, -w_s on the first.
+  for_each_item(static_cast<std::int64_t>(sp.size()), [&](std::int64_t s) {
+    const auto u = static_cast<std::size_t>(s);
+    Eigen::Map<Eigen::Vector3d>(scratch_.data() + 3 * s) =
+        spring_block(sp, u, x) * (v.col(sp.second[u]) - v.col(sp.first[u]));
+  });
+#pragma omp parallel for schedule(static) if (node_count_ >= detail::kParallelMinimum / 4)
+  for (std::int64_t n = 0; n < node_count_; ++n) {
+    Eigen::Vector3d g = out.col(n);
+    for (std::int64_t k = offsets_[n]; k < offsets_[n + 1]; ++k) {
+      const std::int32_t entry = entries_[static_cast<std::size_t>(k)];
+      const Eigen::Map<const Eigen::Vector3d> w(scratch_.data() +
+                                                3 * static_cast<std::int64_t>(entry >> 1));
+      if (entry & 1) {
+        g += w;
+      } else {
+        g -= w;
+      }
+    }
+    out.col(n) = g;
+  }
+}
+
+void SpringKernel::add_hessian_entries(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
+                                       std::vector<Eigen::Triplet<double>>& entries) {
+  const lattice::SpringSet& sp = lat.springs;
+  entries.reserve(entries.size() + 36 * sp.size());
+  for (std::size_t s = 0; s < sp.size(); ++s) {
+    const Eigen::Matrix3d block = spring_block(sp, s, x);
+    const std::int64_t i = sp.first[s];
+    const std::int64_t j = sp.second[s];
+    for (int a = 0; a < 3; ++a) {
+      for (int b = 0; b < 3; ++b) {
+        const double h = block(a, b);
+        entries.emplace_back(3 * i + a, 3 * i + b, h);
+        entries.emplace_back(3 * j + a, 3 * j + b, h);
+        entries.emplace_back(3 * i + a, 3 * j + b, -h);
+        entries.emplace_back(3 * j + a, 3 * i + b, -h);
+      }
+    }
+  }
+}
+
+// ------------------------------------------------------------------------- VolumeKernel
+
+namespace {
+
+// The Hessian product of one cell as its three coefficient vectors t_a, t_b, t_c (the
+// product at vertex k is s_a t_a + s_b t_b + s_c t_c), see elastic_terms.hpp.
+std::array<Eigen::Vector3d, 3> cell_hessian_terms(const lattice::EdgeVectors& e,
+                                                  const lattice::EdgeVectors& d, double kappa,
+                                                  double v0, double force_factor) {
+  const Eigen::Vector3d bxc = e.b.cross(e.c);
+  const Eigen::Vector3d cxa = e.c.cross(e.a);
+  const Eigen::Vector3d axb = e.a.cross(e.b);
+  const double dv = e.a.dot(bxc) / v0 - 1.0;
+  const double d_volume = d.a.dot(bxc) + d.b.dot(cxa) + d.c.dot(axb);  // dV/dx . v
+  const double f1 = 0.25 * force_factor * kappa * d_volume / v0;
+  const double f2 = 0.25 * force_factor * kappa * dv;
+  return {f1 * bxc + f2 * (d.b.cross(e.c) + e.b.cross(d.c)),
+          f1 * cxa + f2 * (d.c.cross(e.a) + e.c.cross(d.a)),
+          f1 * axb + f2 * (d.a.cross(e.b) + e.a.cross(d.b))};
+}
+
+// Signs of lattice::cell_volume_and_gradient: bit 1 = +x face (a), bit 2 = +y (b), bit 0 = +z.
+Eigen::Vector3d vertex_signs(int v) {
+  return {(v & 2) ? 1.0 : -1.0, (v & 4) ? 1.0 : -1.0, (v & 1) ? 1.0 : -1.0};
+}
+
+}  // namespace
+
+VolumeKernel::VolumeKernel(const lattice::Lattice& lat) : node_count_(lat.node_count()) {
+  if (lat.elements.size() >= kIncidenceLimitCells) {
+    throw std::invalid_argument("ElasticTerms: too many cells for 32-bit incidence");
+  }
+  build_incidence(
+      node_count_, static_cast<std::int64_t>(lat.elements.size()), 8,
+      [&](std::int64_t c, int v) { return lat.elements[static_cast<std::size_t>(c)][v]; }, offsets_,
+      entries_);
+}
+
+void VolumeKernel::gather(const std::vector<double>& terms, Eigen::Matrix3Xd& out) const {
+#pragma omp parallel for schedule(static) if (node_count_ >= detail::kParallelMinimum / 4)
+  for (std::int64_t n = 0; n < node_count_; ++n) {
+    Eigen::Vector3d g = out.col(n);
+    for (std::int64_t k = offsets_[n]; k < offsets_[n + 1]; ++k) {
+      const std::int32_t entry = entries_[static_cast<std::size_t>(k)];
+      const int v = entry & 7;
+      const double* t = terms.data() + 9 * static_cast<std::int64_t>(entry >> 3);
+      const double sa = (v & 2) ? 1.0 : -1.0;
+      const double sb = (v & 4) ? 1.0 : -1.0;
+      const double sc = (v & 1) ? 1.0 : -1.0;
+      g += sa * Eigen::Map<const Eigen::Vector3d>(t) +
+           sb * Eigen::Map<const Eigen::Vector3d>(t + 3) +
+           sc * Eigen::Map<const Eigen::Vector3d>(t + 6);
+    }
+    out.col(n) = g;
+  }
+}
+
+ElasticValue VolumeKernel::evaluate(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
+                                    double force_factor, Eigen::Matrix3Xd* gradient) const {
+  check_shapes("VolumeKernel::evaluate", node_count_, lat, x);
   const auto cells = static_cast<std::int64_t>(lat.elements.size());
   const double kappa = lat.polymer.kappa;
   const double v0 = std::pow(lat.element_length, 3);
   const bool want_gradient = gradient != nullptr;
-  if (want_gradient) {
-    tension_.resize(static_cast<std::size_t>(springs));
-    cell_terms_.resize(static_cast<std::size_t>(9 * cells));
-  }
-
-  ElasticEnergies out;
-  // Springs: energy (eq. 4.62) and tension k (l - L)/l (eq. 4.63).
-  const auto spring_sums = detail::fixed_order_sums(springs, [&](std::int64_t s) {
-    const auto u = static_cast<std::size_t>(s);
-    const double l = (x.col(sp.second[u]) - x.col(sp.first[u])).norm();
-    const double stretch = l - sp.rest_length(u);
-    if (want_gradient) tension_[u] = sp.stiffness[u] * stretch / l;
-    const double k_stretch = sp.stiffness[u] * stretch;
-    return std::array<double, 2>{0.5 * k_stretch * stretch, std::abs(k_stretch) * l};
-  });
-  out.springs = spring_sums[0];
-  out.springs_rounding = spring_sums[1];
-  // Cells: energy (eq. 4.64 x V0) and f (b x c), f (c x a), f (a x b) with
+  if (want_gradient) scratch_.resize(static_cast<std::size_t>(9 * cells));
+  // Energy (eq. 4.64 x V0) and f (b x c), f (c x a), f (a x b) with
   // f = factor kappa (V/V0 - 1)/4, so that dU/dx_v = s_a f (b x c) + s_b f (c x a) + s_c f (a x b)
   // (eqs. 4.66-4.69 with the 1/4 of the averaged edge vectors).
-  const double factor = settings_.volume_force_factor;
-  const auto volume_sums = detail::fixed_order_sums(cells, [&](std::int64_t c) {
+  const auto sums = detail::fixed_order_sums(cells, [&](std::int64_t c) {
     const lattice::EdgeVectors e = lattice::averaged_edge_vectors(
         gather_vertices(lat.elements[static_cast<std::size_t>(c)], x));
     const Eigen::Vector3d bxc = e.b.cross(e.c);
     const double dv = e.a.dot(bxc) / v0 - 1.0;
     if (want_gradient) {
-      const double f = 0.25 * factor * kappa * dv;
-      double* t = cell_terms_.data() + 9 * c;
+      const double f = 0.25 * force_factor * kappa * dv;
+      double* t = scratch_.data() + 9 * c;
       Eigen::Map<Eigen::Vector3d> t_bc(t);
       Eigen::Map<Eigen::Vector3d> t_ca(t + 3);
       Eigen::Map<Eigen::Vector3d> t_ab(t + 6);
@@ -161,41 +308,67 @@ ElasticEnergies ElasticTerms::evaluate(const lattice::Lattice& lat, const Eigen:
     }
     return std::array<double, 2>{0.5 * kappa * v0 * dv * dv, std::abs(kappa * v0 * dv)};
   });
-  out.volume = volume_sums[0];
-  out.volume_rounding = volume_sums[1];
-  if (gradient == nullptr) return out;
+  if (want_gradient) gather(scratch_, *gradient);
+  return {sums[0], sums[1]};
+}
 
-  // Gather: every node sums its own springs and cells in a fixed order (no races, no atomics).
-  gradient->resize(3, node_count_);
-#pragma omp parallel for schedule(static) if (node_count_ >= detail::kParallelMinimum / 4)
-  for (std::int64_t n = 0; n < node_count_; ++n) {
-    Eigen::Vector3d g = Eigen::Vector3d::Zero();
-    for (std::int64_t k = spring_offsets_[n]; k < spring_offsets_[n + 1]; ++k) {
-      const std::int32_t entry = spring_entries_[static_cast<std::size_t>(k)];
-      const auto s = static_cast<std::size_t>(entry >> 1);
-      const Eigen::Vector3d r = x.col(sp.second[s]) - x.col(sp.first[s]);
-      if (entry & 1) {
-        g += tension_[s] * r;
-      } else {
-        g -= tension_[s] * r;
+void VolumeKernel::add_hessian_product(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
+                                       double force_factor, const Eigen::Matrix3Xd& v,
+                                       Eigen::Matrix3Xd& out) const {
+  check_shapes("VolumeKernel::add_hessian_product", node_count_, lat, x);
+  const auto cells = static_cast<std::int64_t>(lat.elements.size());
+  const double v0 = std::pow(lat.element_length, 3);
+  scratch_.resize(static_cast<std::size_t>(9 * cells));
+  for_each_item(cells, [&](std::int64_t c) {
+    const auto& element = lat.elements[static_cast<std::size_t>(c)];
+    const std::array<Eigen::Vector3d, 3> t =
+        cell_hessian_terms(lattice::averaged_edge_vectors(gather_vertices(element, x)),
+                           lattice::averaged_edge_vectors(gather_vertices(element, v)),
+                           lat.polymer.kappa, v0, force_factor);
+    for (int k = 0; k < 3; ++k) Eigen::Map<Eigen::Vector3d>(scratch_.data() + 9 * c + 3 * k) = t[k];
+  });
+  gather(scratch_, out);
+}
+
+void VolumeKernel::add_hessian_entries(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
+                                       double force_factor,
+                                       std::vector<Eigen::Triplet<double>>& entries) {
+  const double v0 = std::pow(lat.element_length, 3);
+  entries.reserve(entries.size() + 576 * lat.elements.size());
+  for (const auto& element : lat.elements) {
+    const lattice::EdgeVectors e = lattice::averaged_edge_vectors(gather_vertices(element, x));
+    // Column (l, b) of the cell's block: its product with the unit vector of that coordinate.
+    for (int l = 0; l < 8; ++l) {
+      for (int b = 0; b < 3; ++b) {
+        lattice::CellVertices unit;
+        for (int k = 0; k < 8; ++k) unit[k] = Eigen::Vector3d::Zero();
+        unit[l][b] = 1.0;
+        const std::array<Eigen::Vector3d, 3> t = cell_hessian_terms(
+            e, lattice::averaged_edge_vectors(unit), lat.polymer.kappa, v0, force_factor);
+        for (int k = 0; k < 8; ++k) {
+          const Eigen::Vector3d s = vertex_signs(k);
+          const Eigen::Vector3d column = s[0] * t[0] + s[1] * t[1] + s[2] * t[2];
+          for (int a = 0; a < 3; ++a) {
+            entries.emplace_back(3 * static_cast<std::int64_t>(element[k]) + a,
+                                 3 * static_cast<std::int64_t>(element[l]) + b, column[a]);
+          }
+        }
       }
     }
-    for (std::int64_t k = cell_offsets_[n]; k < cell_offsets_[n + 1]; ++k) {
-      const std::int32_t entry = cell_entries_[static_cast<std::size_t>(k)];
-      const int v = entry & 7;
-      const double* t = cell_terms_.data() + 9 * static_cast<std::int64_t>(entry >> 3);
-      // Signs of lattice::cell_volume_and_gradient: bit 1 = +x face (a), bit 2 = +y (b),
-      // bit 0 = +z (c).
-      const double sa = (v & 2) ? 1.0 : -1.0;
-      const double sb = (v & 4) ? 1.0 : -1.0;
-      const double sc = (v & 1) ? 1.0 : -1.0;
-      g += sa * Eigen::Map<const Eigen::Vector3d>(t) +
-           sb * Eigen::Map<const Eigen::Vector3d>(t + 3) +
-           sc * Eigen::Map<const Eigen::Vector3d>(t + 6);
-    }
-    gradient->col(n) = g;
   }
-  return out;
+}
+
+// ------------------------------------------------------------------------- ElasticTerms
+
+ElasticTerms::ElasticTerms(const lattice::Lattice& lat, ElasticTermSettings settings)
+    : settings_(settings), springs_(lat), volume_(lat) {}
+
+ElasticEnergies ElasticTerms::evaluate(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
+                                       Eigen::Matrix3Xd* gradient) const {
+  if (gradient != nullptr) gradient->setZero(3, x.cols());
+  const ElasticValue s = springs_.evaluate(lat, x, gradient);
+  const ElasticValue v = volume_.evaluate(lat, x, settings_.volume_force_factor, gradient);
+  return {s.energy, v.energy, s.rounding, v.rounding};
 }
 
 }  // namespace mresim::mess

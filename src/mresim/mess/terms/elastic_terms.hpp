@@ -20,6 +20,7 @@
 // forces are is springs + volume_force_factor * volume (the "potential", see system_energy.hpp).
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -65,12 +66,83 @@ struct ElasticEnergies {
   double volume_rounding = 0.0;
 };
 
-// Energies and gradient of both terms for one lattice, parallelised with OpenMP so that the
-// result is bitwise independent of the thread count: every spring's tension and every cell's
-// volume derivative is computed once into scratch arrays, then every node gathers its own
-// contributions in a fixed order (node -> incident springs and cells, built once). Energies are
-// summed in fixed blocks (fixed_order.hpp). Not safe for concurrent calls on one object (the
-// scratch arrays are shared); copies are independent.
+// The two elastic kernels, parallelised with OpenMP so that every result is bitwise
+// independent of the thread count: every spring's tension and every cell's volume derivative
+// is computed once into scratch arrays, then every node gathers its own contributions in a
+// fixed order (node -> incident springs or cells, built once). Energies are summed in fixed
+// blocks (fixed_order.hpp). Gradients and Hessian products are ADDED per node in the order
+// g = out.col(n); g += contributions; out.col(n) = g, so a springs pass followed by a volume
+// pass gives the same bits as one fused pass. Not safe for concurrent calls on one object
+// (the scratch arrays are shared); copies are independent. `lattice` must be the one given to
+// the constructor.
+
+struct ElasticValue {
+  double energy = 0.0;    // J
+  double rounding = 0.0;  // see ElasticEnergies
+};
+
+// Springs, eq. 4.62, and its exact Hessian: per spring the 3 x 3 block
+// B = k [(1 - L/l) I + (L/l) r^ r^T] (r = x_j - x_i, l = |r|), with H_jj = H_ii = B and
+// H_ij = H_ji = -B.
+class SpringKernel {
+ public:
+  SpringKernel() = default;
+  explicit SpringKernel(const lattice::Lattice& lattice);
+
+  // Energy; adds the gradient to `gradient` (3 x N) if not null.
+  ElasticValue evaluate(const lattice::Lattice& lattice, const Eigen::Matrix3Xd& x,
+                        Eigen::Matrix3Xd* gradient) const;
+  // out += H v (all 3 x N).
+  void add_hessian_product(const lattice::Lattice& lattice, const Eigen::Matrix3Xd& x,
+                           const Eigen::Matrix3Xd& v, Eigen::Matrix3Xd& out) const;
+  // 36 entries per spring, rows/columns 3 n + a, in spring order.
+  static void add_hessian_entries(const lattice::Lattice& lattice, const Eigen::Matrix3Xd& x,
+                                  std::vector<Eigen::Triplet<double>>& entries);
+
+ private:
+  std::int64_t node_count_ = 0;
+  // Node -> incident springs: entries 2 s + (node is the spring's second end).
+  std::vector<std::int64_t> offsets_;
+  std::vector<std::int32_t> entries_;
+  // Scratch: tension k (l - L)/l per spring, or B (v_j - v_i) (3 per spring).
+  mutable std::vector<double> scratch_;
+};
+
+// Volume elements, eq. 4.64 x V0, times force_factor in gradients and Hessians. Exact Hessian
+// of U = 1/2 kappa V0 (V/V0 - 1)^2 per cell:
+//   H v = kappa/V0 (dV/dx . v) dV/dx + kappa (V/V0 - 1) d(dV/dx)[v],
+// V = a . (b x c) with the averaged edge vectors (the 1/4 included), so that
+// d(dV/dx_k)[v] = (s_a (db x c + b x dc) + s_b (dc x a + c x da) + s_c (da x b + a x db)) / 4,
+// da, db, dc the averaged edge vectors of v.
+class VolumeKernel {
+ public:
+  VolumeKernel() = default;
+  explicit VolumeKernel(const lattice::Lattice& lattice);
+
+  ElasticValue evaluate(const lattice::Lattice& lattice, const Eigen::Matrix3Xd& x,
+                        double force_factor, Eigen::Matrix3Xd* gradient) const;
+  void add_hessian_product(const lattice::Lattice& lattice, const Eigen::Matrix3Xd& x,
+                           double force_factor, const Eigen::Matrix3Xd& v,
+                           Eigen::Matrix3Xd& out) const;
+  // 576 entries per cell (its dense 24 x 24 block), in cell order.
+  static void add_hessian_entries(const lattice::Lattice& lattice, const Eigen::Matrix3Xd& x,
+                                  double force_factor,
+                                  std::vector<Eigen::Triplet<double>>& entries);
+
+ private:
+  // Node gather of per-cell vectors t (9 per cell: the s_a, s_b, s_c coefficients).
+  void gather(const std::vector<double>& terms, Eigen::Matrix3Xd& out) const;
+
+  std::int64_t node_count_ = 0;
+  // Node -> incident cells: entries 8 c + v (v = the node's local vertex in cell c).
+  std::vector<std::int64_t> offsets_;
+  std::vector<std::int32_t> entries_;
+  // Scratch: per cell the three vectors t_a, t_b, t_c (see gather).
+  mutable std::vector<double> scratch_;
+};
+
+// Both kernels, as one evaluator of springs + volume (used by tests and benchmarks; the
+// system evaluates them as two terms, terms/elastic_term_types.cpp).
 class ElasticTerms {
  public:
   ElasticTerms() = default;
@@ -80,24 +152,14 @@ class ElasticTerms {
   void set_settings(const ElasticTermSettings& settings) { settings_ = settings; }
 
   // Energies at x (3 x N, m). If `gradient` is not null it is overwritten with
-  // d(springs)/dx + volume_force_factor d(volume)/dx (J/m). `lattice` must be the one given to
-  // the constructor.
+  // d(springs)/dx + volume_force_factor d(volume)/dx (J/m).
   ElasticEnergies evaluate(const lattice::Lattice& lattice, const Eigen::Matrix3Xd& x,
                            Eigen::Matrix3Xd* gradient) const;
 
  private:
   ElasticTermSettings settings_;
-  std::int64_t node_count_ = 0;
-  // Node -> incident springs: entries 2 s + (node is the spring's second end).
-  std::vector<std::int64_t> spring_offsets_;
-  std::vector<std::int32_t> spring_entries_;
-  // Node -> incident cells: entries 8 c + v (v = the node's local vertex in cell c).
-  std::vector<std::int64_t> cell_offsets_;
-  std::vector<std::int32_t> cell_entries_;
-  // Scratch: tension k (l - L)/l per spring; per cell the three vectors
-  // f (b x c), f (c x a), f (a x b) with f = factor kappa (V/V0 - 1) / 4.
-  mutable std::vector<double> tension_;
-  mutable std::vector<double> cell_terms_;
+  SpringKernel springs_;
+  VolumeKernel volume_;
 };
 
 }  // namespace mresim::mess

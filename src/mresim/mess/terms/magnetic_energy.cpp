@@ -183,6 +183,16 @@ WcaValue wca_pair(const WcaParameters& wca, double s) {
   return v;
 }
 
+double wca_pair_curvature(const WcaParameters& wca, double s) {
+  const double rc = wca.r_cut();
+  if (!(wca.e_max > 0.0) || !(s < rc)) return 0.0;
+  const double s2 = s * s;
+  const double w =
+      (rc - s) * (rc + s) * (rc * rc + rc * s + s2) * (rc * rc - rc * s + s2) / (s2 * s2 * s2);
+  // d/dS of dE/dS = -12 E_max (w + w^2) / S with dw/dS = -6 (1 + w) / S.
+  return 12.0 * wca.e_max * (1.0 + w) * (6.0 + 13.0 * w) / s2;
+}
+
 double wca_energy(const MagneticModel& model, const PairList& pairs) {
   double sum = 0.0;
   for (const ParticlePair& p : pairs) sum += wca_pair(model.wca, p.r.norm()).energy;

@@ -98,6 +98,8 @@ struct WcaValue {
   double derivative = 0.0;
 };
 WcaValue wca_pair(const WcaParameters& wca, double separation);
+// d^2E/dS^2 of one pair, 12 E_max (1 + w)(6 + 13 w) / S^2 (0 at and beyond the cut-off).
+double wca_pair_curvature(const WcaParameters& wca, double separation);
 
 struct MagneticEnergyBreakdown {
   double zeeman = 0.0;
