@@ -9,6 +9,7 @@
 #include <random>
 #include <vector>
 
+#include "finite_differences.hpp"
 #include "mresim/core/constants.hpp"
 #include "mresim/mess/lattice/lattice.hpp"
 #include "mresim/mess/profile/model_profile.hpp"
@@ -42,21 +43,6 @@ inline Eigen::Matrix3Xd perturbed(const Eigen::Matrix3Xd& x, double amplitude,
   Eigen::Matrix3Xd y = x;
   for (Eigen::Index k = 0; k < y.size(); ++k) y.data()[k] += u(gen);
   return y;
-}
-
-// Central differences of f over the listed flat coordinates of x.
-inline std::vector<double> central_differences(
-    const std::function<double(const Eigen::Matrix3Xd&)>& f, const Eigen::Matrix3Xd& x,
-    const std::vector<Eigen::Index>& coordinates, double step) {
-  std::vector<double> out;
-  for (const Eigen::Index k : coordinates) {
-    Eigen::Matrix3Xd p = x;
-    Eigen::Matrix3Xd m = x;
-    p.data()[k] += step;
-    m.data()[k] -= step;
-    out.push_back((f(p) - f(m)) / (2.0 * step));
-  }
-  return out;
 }
 
 inline std::vector<Eigen::Index> all_coordinates(const Eigen::Matrix3Xd& x) {

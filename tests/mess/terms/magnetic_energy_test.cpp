@@ -14,6 +14,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "../support/finite_differences.hpp"
 #include "mresim/core/constants.hpp"
 #include "mresim/mess/magnetization/self_consistent.hpp"
 
@@ -46,17 +47,10 @@ Eigen::Matrix3Xd some_magnetizations(Eigen::Index n) {
   return M;
 }
 
-// Central differences over all 3N coordinates.
+// Central differences over all 3N coordinates (the shared helper of tests/mess/support).
 Eigen::Matrix3Xd numeric_gradient(const std::function<double(const Eigen::Matrix3Xd&)>& energy,
                                   const Eigen::Matrix3Xd& c, double step) {
-  Eigen::Matrix3Xd g(3, c.cols());
-  for (Eigen::Index k = 0; k < c.size(); ++k) {
-    Eigen::Matrix3Xd p = c, m = c;
-    p.data()[k] += step;
-    m.data()[k] -= step;
-    g.data()[k] = (energy(p) - energy(m)) / (2.0 * step);
-  }
-  return g;
+  return mresim::mess::testing::central_difference_gradient(energy, c, step);
 }
 
 // Spread-out, near-contact (gaps 0.03-0.2 R, inside the WCA range) and overlapping (2.0 R
