@@ -85,7 +85,7 @@ void read_model(const std::optional<TableReader>& model, MessSpec& s) {
   l.poisson_ratio = t.number_or("poisson_ratio", 0.47, Range::open(-1.0, 0.5), "");
   if (l.poisson_ratio <= s.profile->poisson_ratio_lower_limit) {
     t.fail("poisson_ratio", t.value_text("poisson_ratio"),
-           fmt::format("must be > {:.4f} with profile = \"{}\": {}; use profile = \"physical\"",
+           fmt::format(R"(must be > {:.4f} with profile = "{}": {}; use profile = "physical")",
                        s.profile->poisson_ratio_lower_limit, s.profile->name,
                        s.profile->poisson_ratio_limit_reason));
   }
