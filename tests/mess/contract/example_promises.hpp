@@ -28,6 +28,7 @@ struct RunData {
   std::vector<double> separation_um;  // /steps/separation (closest pair of centres)
   std::vector<double> m_along_ms;     // /steps/magnetization_projection (units of Ms)
   std::vector<double> wca_energy_j;   // /steps/energies/wca
+  std::filesystem::path results;      // for the energies of other terms (energy_J)
   std::vector<std::int64_t> cluster_count, largest_cluster, converged, valid;
   std::vector<std::vector<std::int64_t>> cluster_id;  // [step][particle]
   std::vector<std::vector<double>> displacement_um;   // [step][3 * particle + axis], c - c_0
@@ -71,6 +72,7 @@ inline std::vector<double> scaled(std::vector<double> v, double factor) {
 inline RunData read_run(const std::filesystem::path& results) {
   const Hdf5Reader h5(results);
   RunData r;
+  r.results = results;
   r.field_mT = scaled(h5.doubles("/steps/field_projection"), 1e3);
   r.load = h5.doubles("/steps/load_value");
   r.separation_um = scaled(h5.doubles("/steps/separation"), 1e6);
@@ -156,6 +158,11 @@ inline double quantity(const RunData& r, const nlohmann::json& check, std::size_
   if (q == "separation_um") return r.separation_um[i];
   if (q == "M_along_Ms") return r.m_along_ms[i];
   if (q == "wca_energy_J") return r.wca_energy_j[i];
+  if (q == "energy_J") {  // with "term": the dataset /steps/energies/<term>
+    return Hdf5Reader(r.results)
+        .doubles("/steps/energies/" + check.at("term").get<std::string>())
+        .at(i);
+  }
   if (q == "cluster_count") return static_cast<double>(r.cluster_count[i]);
   if (q == "largest_cluster") return static_cast<double>(r.largest_cluster[i]);
   if (q == "pair_clusters") return pair_clusters(r.cluster_id[i]);
@@ -177,17 +184,20 @@ inline std::string describe(const nlohmann::json& check) {
 }
 
 // Failures of one check (empty when it holds). Forms: min/max bounds, or equals, on the value
-// at every selected index; with `minus`, on the value minus the value at the index the `minus`
-// selector picks (paired in order, so both selectors must pick the same number of indices).
+// at every selected index; with `minus` (`plus`), on the value minus (plus) the value at the
+// index that selector picks (paired in order: both selectors must pick equally many indices).
 inline std::vector<std::string> evaluate(const RunData& r, const nlohmann::json& check) {
   const bool fits = is_fit_quantity(check.at("quantity").get<std::string>());
   if (fits && !r.has_fits) return {describe(check) + ": this run wrote no modulus fits"};
   const auto picked = select(r, fits, check.at("at"));
+  // `minus` or `plus`: the value at the paired index of a second selector is subtracted/added.
+  const char* other = check.contains("minus") ? "minus" : (check.contains("plus") ? "plus" : "");
+  const double sign = std::string(other) == "plus" ? 1.0 : -1.0;
   std::vector<std::size_t> base;
-  if (check.contains("minus")) base = select(r, fits, check["minus"]);
+  if (*other != '\0') base = select(r, fits, check[other]);
   if (picked.empty()) return {describe(check) + ": the selector picks nothing"};
-  if (check.contains("minus") && base.size() != picked.size()) {
-    return {describe(check) + ": 'at' and 'minus' pick different numbers of entries"};
+  if (*other != '\0' && base.size() != picked.size()) {
+    return {describe(check) + ": 'at' and '" + other + "' pick different numbers of entries"};
   }
   if (!check.contains("min") && !check.contains("max") && !check.contains("equals")) {
     throw std::runtime_error(describe(check) + ": no min, max or equals");
@@ -195,7 +205,7 @@ inline std::vector<std::string> evaluate(const RunData& r, const nlohmann::json&
   std::vector<std::string> failures;
   for (std::size_t k = 0; k < picked.size(); ++k) {
     double v = quantity(r, check, picked[k]);
-    if (!base.empty()) v -= quantity(r, check, base[k]);
+    if (!base.empty()) v += sign * quantity(r, check, base[k]);
     const bool ok = (!check.contains("min") || v >= check["min"].get<double>()) &&
                     (!check.contains("max") || v <= check["max"].get<double>()) &&
                     (!check.contains("equals") || v == check["equals"].get<double>());

@@ -144,6 +144,12 @@ TEST(ExamplePromiseEvaluator, TrueClaimsPassAndFalseOnesFail) {
   EXPECT_EQ(check(R"({"quantity":"centre_displacement_um","particle":1,"axis":"z",
                       "at":{"step":1},"max":-0.4})"),
             0U);
+  EXPECT_EQ(check(R"({"quantity":"M_along_Ms","at":{"step":1},"plus":{"step":3},
+                      "min":-1e-12,"max":1e-12})"),
+            0U);
+  EXPECT_EQ(check(R"({"quantity":"M_along_Ms","at":{"step":1},"minus":{"step":3},
+                      "min":-1e-12,"max":1e-12})"),
+            1U);
   // A selector that picks nothing is a failure, not a pass.
   EXPECT_EQ(check(R"({"quantity":"M_along_Ms","at":{"leg":0,"B_mT":-20},"min":0})"), 1U);
   // A strain-run quantity on a run without modulus fits is a failure.
