@@ -25,11 +25,11 @@
 #include <algorithm>
 #include <any>
 #include <cmath>
-#include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "mresim/config/table_reader.hpp"
 #include "mresim/core/constants.hpp"
@@ -79,8 +79,8 @@ std::any read_field_gradient(const config::TableReader& t) {
            "expected 9 numbers [dHx/dx, dHx/dy, dHx/dz, dHy/dx, ..., dHz/dz] (A/m^2)");
   }
   FieldGradient p;
-  for (int a = 0; a < 3; ++a) {
-    for (int b = 0; b < 3; ++b) p.gradient(a, b) = g[static_cast<std::size_t>(3 * a + b)];
+  for (std::size_t k = 0; k < 9; ++k) {
+    p.gradient(static_cast<Eigen::Index>(k / 3), static_cast<Eigen::Index>(k % 3)) = g[k];
   }
   check_gradient(t, p.gradient);
   if (const auto o = t.optional_number_list("origin", config::Range::any(), "m", 3)) {
@@ -93,8 +93,9 @@ std::any read_field_gradient(const config::TableReader& t) {
 
 class FieldGradientTerm final : public EnergyTerm {
  public:
-  FieldGradientTerm(const Eigen::Matrix3d& gradient, const Eigen::Vector3d& origin)
-      : gradient_(gradient), origin_(origin) {}
+  // Fixed-size Eigen values (no alignment requirement): copied in.
+  FieldGradientTerm(Eigen::Matrix3d gradient, Eigen::Vector3d origin)
+      : gradient_(std::move(gradient)), origin_(std::move(origin)) {}
 
   std::string_view name() const override { return "field_gradient"; }
   std::string_view equation() const override { return "eqs. 4.70, 4.77"; }
