@@ -11,6 +11,7 @@
 #include "mresim/mess/analysis/clusters.hpp"
 #include "mresim/mess/analysis/modulus_fit.hpp"
 #include "mresim/mess/outputs/step_records_io.hpp"
+#include "mresim/mess/protocols/protocol.hpp"
 #include "mresim/mess/protocols/step_plan.hpp"
 
 namespace mresim::mess_protocol {
@@ -112,13 +113,6 @@ StepExtras step_extras(const ProtocolRunner& runner, const std::vector<StepRecor
   return x;
 }
 
-std::string modulus_name(const mc::MessSpec& spec) {
-  const mc::LoadKind kind = spec.strain ? spec.strain->kind : spec.stress->kind;
-  if (kind == mc::LoadKind::shear) return "G_eff";
-  if (kind == mc::LoadKind::torsion) return "torsion_stiffness";
-  return "E_eff";
-}
-
 // The modulus of every field (Section 4.2.8) with what the outputs say about its fit.
 struct FieldFits {
   std::vector<double> magnitude;  // T
@@ -134,8 +128,9 @@ struct FieldFits {
   std::vector<std::string> problem;    // "" where valid
 };
 
-FieldFits fit_fields(const mc::MessSpec& spec, const std::vector<StepRecord>& records,
-                     const StepExtras& extras) {
+// The fit is the one the protocol names (protocols/protocol.hpp, Analysis).
+FieldFits fit_fields(const mc::MessSpec& spec, const Analysis& analysis,
+                     const std::vector<StepRecord>& records, const StepExtras& extras) {
   FieldFits out;
   const std::size_t fields = spec.field.values.size();
   for (std::size_t f = 0; f < fields; ++f) {
@@ -151,10 +146,9 @@ FieldFits fit_fields(const mc::MessSpec& spec, const std::vector<StepRecord>& re
       converged.push_back(records[i].converged);
     }
     out.magnitude.push_back(spec.field.values[f].norm());
-    if (spec.strain) {
+    if (analysis.kind == AnalysisKind::energy_modulus) {
       ma::FitOptions options;
-      // The original's zero-point rule is for shear (modulus_fit.hpp).
-      options.drop_zero_point_above_next = spec.strain->kind == mc::LoadKind::shear;
+      options.drop_zero_point_above_next = analysis.drop_zero_point_above_next;
       options.converged = converged;
       const ma::QuadraticFit fit = ma::fit_energy_density(strain, density, options);
       out.modulus.push_back(fit.modulus);
@@ -189,8 +183,10 @@ void write_analysis(const fs::path& run_dir, io::Hdf5File& results, const Protoc
                     const std::vector<StepRecord>& records, const StepExtras& extras,
                     MessResultCheck& check) {
   const mc::MessSpec& spec = runner.spec();
-  const FieldFits fits = fit_fields(spec, records, extras);
-  const std::string name = modulus_name(spec);
+  const Analysis analysis = spec.protocol->analysis();
+  const bool energy = analysis.kind == AnalysisKind::energy_modulus;
+  const FieldFits fits = fit_fields(spec, analysis, records, extras);
+  const std::string& name = analysis.modulus_name;
   for (std::size_t f = 0; f < fits.valid.size(); ++f) {
     if (fits.valid[f] != 0) continue;
     check.invalid_fits.push_back(fmt::format("{} at |B| = {:.4g} T (field {}): {}", name,
@@ -200,12 +196,12 @@ void write_analysis(const fs::path& run_dir, io::Hdf5File& results, const Protoc
   const char* unit = name == "torsion_stiffness" ? "J/m^3" : "Pa";
   results.write_string_attribute("/analysis", "modulus_name", name);
   results.write_string_attribute("/analysis", "method",
-                                 spec.strain ? "energy density = a x^2/2 + c, least squares"
-                                             : "stress = a x, least squares through 0");
+                                 energy ? "energy density = a x^2/2 + c, least squares"
+                                        : "stress = a x, least squares through 0");
   results.write_vector("/analysis/field_magnitude", fits.magnitude, "T");
   results.write_vector("/analysis/modulus", fits.modulus, unit);
   results.write_vector("/analysis/offset", fits.offset, "J/m^3");
-  results.write_vector("/analysis/rms_residual", fits.rms, spec.strain ? "J/m^3" : "Pa");
+  results.write_vector("/analysis/rms_residual", fits.rms, energy ? "J/m^3" : "Pa");
   results.write_int_vector("/analysis/first_point", fits.first);
   results.write_int_vector("/analysis/fit_points", fits.points);
   results.write_int_vector("/analysis/split", fits.split);
@@ -311,10 +307,10 @@ std::string MessResultCheck::message() const {
 
 namespace {
 
-// "step 3 (B = 0.04 T, load 0.02 rad)" (the load only for strain and stress runs).
+// "step 3 (B = 0.04 T, load 0.02 rad)" (the load only for protocols with one).
 std::string step_place(const mc::MessSpec& spec, const StepRecord& r) {
   const double b = r.step.field.dot(field_direction(spec));
-  if (!spec.strain && !spec.stress) return fmt::format("step {} (B = {:.4g} T)", r.step.index, b);
+  if (!spec.protocol->has_load()) return fmt::format("step {} (B = {:.4g} T)", r.step.index, b);
   return fmt::format("step {} (B = {:.4g} T, load {:.4g} {})", r.step.index, b, r.step.load_value,
                      load_unit(spec));
 }
@@ -403,7 +399,9 @@ MessResultCheck write_mess_results(const fs::path& run_dir, io::Hdf5File& result
   results.write_int_vector("/steps/largest_cluster", x.largest_cluster);
   results.write_int_array("/steps/cluster_id", {records.size(), np}, x.cluster_id);
   write_summary(run_dir, records, x, valid, unit, *runner.system().energy_labels());
-  if (spec.strain || spec.stress) write_analysis(run_dir, results, runner, records, x, check);
+  if (spec.protocol->analysis().kind != AnalysisKind::none) {
+    write_analysis(run_dir, results, runner, records, x, check);
+  }
   if (spec.output.node_positions) write_xdmf(run_dir, runner, records);
   return check;
 }

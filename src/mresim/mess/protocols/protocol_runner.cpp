@@ -7,7 +7,7 @@
 
 #include "mresim/core/constants.hpp"
 #include "mresim/mess/lattice/volume_elements.hpp"
-#include "mresim/mess/protocols/loading.hpp"
+#include "mresim/mess/protocols/protocol.hpp"
 #include "mresim/mess/solvers/leapfrog.hpp"
 #include "mresim/mess/solvers/minimiser.hpp"
 
@@ -30,29 +30,6 @@ mess::MessSystem make_system(const mc::MessSpec& spec) {
   settings.magnetization = spec.solver.magnetization;
   settings.magnetization.demagnetization = spec.demagnetization;
   return {std::move(lat), std::move(model), settings, spec.terms};
-}
-
-// The load of one step; `reference` as loading.hpp describes.
-LoadState load_of(const mc::MessSpec& spec, const lattice::Lattice& lat, const StepSpec& step,
-                  const Eigen::Matrix3Xd& reference) {
-  switch (spec.run_type) {
-    case mc::MessRunType::hysteresis:
-      return hysteresis_load(lat, reference);
-    case mc::MessRunType::magnetostriction:
-      return magnetostriction_load(lat, reference);
-    case mc::MessRunType::strain:
-      return strain_load(lat, *spec.strain, step.load_value, reference);
-    case mc::MessRunType::stress:
-      return stress_load(lat, *spec.stress, step.load_value, reference);
-  }
-  throw std::logic_error("mess_protocol: unknown run type");
-}
-
-// The strain axis of the modulus fit for strain runs: tan(gamma) for shear (the engineering
-// shear strain of the affine field u = h tan(gamma), for which linear elasticity gives the
-// energy density G tan^2(gamma)/2), the engineering strain, the twist angle.
-double applied_strain(const mc::StrainSpec& strain, double value) {
-  return strain.kind == mc::LoadKind::shear ? std::tan(value) : value;
 }
 
 }  // namespace
@@ -98,10 +75,12 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   const StepSpec& step = steps_[state.next_step];
   const lattice::Lattice& lat = system_.lattice();
 
-  // Boundary conditions: loaded steps are measured from the zero-load state at this field.
-  const bool loaded = step.load_index > 0 && spec_.run_type == mc::MessRunType::strain;
+  // Boundary conditions (the protocol's): loaded steps of a protocol that says so are measured
+  // from the zero-load state at this field.
+  const Protocol& protocol = *spec_.protocol;
+  const bool loaded = step.load_index > 0 && protocol.loads_from_zero_load_state();
   const Eigen::Matrix3Xd& reference = loaded ? state.references[step.field_index] : lat.positions;
-  LoadState load = load_of(spec_, lat, step, reference);
+  LoadState load = protocol.load(lat, step, reference);
 
   const SlotState* start = start_state(step, state);
   system_.set_constraints(std::move(load.constraints));
@@ -156,13 +135,9 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   record.centres = system_.particle_centres();
   record.magnetization = system_.magnetizations();
   record.system_volume = system_volume(lat, system_.positions());
-  if (spec_.strain) {
-    record.measured_strain = applied_strain(*spec_.strain, step.load_value);
-  } else if (spec_.stress) {
-    const Eigen::Matrix3Xd& zero_stress =
-        step.load_index > 0 ? state.references[step.field_index] : system_.positions();
-    record.measured_strain = measured_strain(lat, *spec_.stress, system_.positions(), zero_stress);
-  }
+  const Eigen::Matrix3Xd& zero_load =
+      step.load_index > 0 ? state.references[step.field_index] : system_.positions();
+  record.measured_strain = protocol.measured_strain(lat, step, system_.positions(), zero_load);
 
   // Advance the state.
   SlotState& slot = state.slots[slot_of_field(step.field_index)];

@@ -1,41 +1,18 @@
 #include "mresim/mess/protocols/step_plan.hpp"
 
+#include "mresim/mess/protocols/protocol.hpp"
+
 namespace mresim::mess_protocol {
 
 namespace mc = mresim::mess_config;
 
-std::vector<double> load_values(const mc::MessSpec& spec) {
-  if (spec.strain) return spec.strain->values;
-  if (spec.stress) return spec.stress->values;
-  return {0.0};
-}
+// The protocol decides (protocol.hpp); these keep the callers free of it.
+std::vector<double> load_values(const mc::MessSpec& spec) { return spec.protocol->load_values(); }
 
-const char* load_unit(const mc::MessSpec& spec) {
-  if (spec.stress) return "Pa";
-  if (spec.strain) {
-    const mc::LoadKind k = spec.strain->kind;
-    return k == mc::LoadKind::shear || k == mc::LoadKind::torsion ? "rad" : "1";
-  }
-  return "1";
-}
+const char* load_unit(const mc::MessSpec& spec) { return spec.protocol->load_unit(); }
 
 std::vector<StepSpec> plan_steps(const mc::MessSpec& spec) {
-  const std::vector<double> loads = load_values(spec);
-  const std::size_t fields = spec.field.values.size();
-  std::vector<StepSpec> steps;
-  steps.reserve(loads.size() * fields);
-  for (std::size_t l = 0; l < loads.size(); ++l) {
-    for (std::size_t f = 0; f < fields; ++f) {
-      StepSpec s;
-      s.index = steps.size();
-      s.field_index = f;
-      s.load_index = l;
-      s.field = spec.field.values[f];
-      s.load_value = loads[l];
-      steps.push_back(s);
-    }
-  }
-  return steps;
+  return spec.protocol->plan_steps(spec);
 }
 
 Eigen::Vector3d field_direction(const mc::MessSpec& spec) {

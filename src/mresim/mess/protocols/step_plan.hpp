@@ -1,9 +1,9 @@
 #pragma once
 
-// The relaxation steps of a 3D run (Section 4.2.7; docs/original-code.md#step-order): one per
-// applied field for hysteresis and magnetostriction; for strain and stress runs an outer loop
-// over the load values and an inner loop over the fields, step n = load_index x F +
-// field_index (F fields).
+// The relaxation steps of a 3D run (Section 4.2.7; docs/original-code.md#step-order), as the
+// run's protocol plans them (protocol.hpp): one per applied field for hysteresis and
+// magnetostriction; for strain and stress runs an outer loop over the load values and an inner
+// loop over the fields, step n = load_index x F + field_index (F fields).
 
 #include <Eigen/Core>
 #include <cstddef>
@@ -23,11 +23,11 @@ struct StepSpec {
 
 std::vector<StepSpec> plan_steps(const mess_config::MessSpec& spec);
 
-// The load values of the run (the strain or stress values; {0} for the other run types).
+// The load values of the run's protocol (the strain or stress values; {0} without a load).
 std::vector<double> load_values(const mess_config::MessSpec& spec);
 
 // The unit of the load values: "rad" (shear, torsion), "1" (tension, compression), "Pa"
-// (stress); "1" for the run types without a load.
+// (stress); "1" for the protocols without a load.
 const char* load_unit(const mess_config::MessSpec& spec);
 
 // The direction the run's fields are measured along (Fig. 4.4's field axis): the unit vector

@@ -9,19 +9,17 @@
 #include <numbers>
 
 #include "mresim/core/constants.hpp"
+#include "mresim/mess/protocols/protocol.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
 
 namespace mresim::mess_config {
 
 namespace {
 
-constexpr double kRadian = 180.0 / std::numbers::pi;
 // Centres listed one by one up to this many particles; the closest pair is searched up to
 // kClosestPairLimit particles (O(N^2)).
 constexpr std::size_t kCentresShown = 64;
 constexpr std::size_t kClosestPairLimit = 4000;
-
-const char* axis_name(int a) { return a == 0 ? "x" : a == 1 ? "y" : "z"; }
 
 std::string with_thousands(std::int64_t n) {
   std::string digits = fmt::format("{}", n < 0 ? -n : n);
@@ -216,61 +214,8 @@ void describe_field(const MessSpec& s, app::InfoReport& r) {
         f.sequence == FieldSequence::loop ? "0 -> max -> -max -> max" : "the magnitudes in order");
   }
   r.add_integer(sec, "fields", static_cast<std::int64_t>(f.values.size()),
-                s.run_type == MessRunType::strain || s.run_type == MessRunType::stress
-                    ? "applied at every load value"
-                    : "relaxations");
+                s.protocol->has_load() ? "applied at every load value" : "relaxations");
   r.add(sec, "max_reduced_field", f.max / (kMu0 * s.particles.Ms), "", "h = B/(mu0 Ms)");
-}
-
-template <typename Spec>
-void describe_axes(const Spec& spec, const std::string& sec, app::InfoReport& r) {
-  r.add_text(sec, "kind", to_string(spec.kind));
-  r.add_text(sec, "normal", axis_name(spec.normal), "loaded faces are normal to this axis");
-  if (spec.kind == LoadKind::shear) {
-    r.add_text(sec, "direction", axis_name(spec.direction), "displacement or traction axis");
-  }
-}
-
-void describe_loads(const MessSpec& s, app::InfoReport& r) {
-  if (s.strain) {
-    const StrainSpec& st = *s.strain;
-    const std::string sec = "strain";
-    describe_axes(st, sec, r);
-    if (st.kind == LoadKind::shear) {
-      r.add_text(sec, "boundary",
-                 st.boundary == ShearBoundary::all_faces ? "all_faces" : "normal_faces",
-                 st.boundary == ShearBoundary::all_faces
-                     ? "every surface node follows u = h tan(gamma) (eq. 4.96)"
-                     : "faces normal to the normal axis held, side faces free");
-    }
-    const auto [lo, hi] = std::minmax_element(st.values.begin(), st.values.end());
-    const bool angle = st.kind == LoadKind::torsion;
-    const double scale = angle ? kRadian : 1.0;
-    const std::string unit = st.kind == LoadKind::shear ? "rad" : angle ? "deg" : "";
-    r.add(sec, "min", *lo * scale, unit,
-          st.kind == LoadKind::compression ? "compression is negative" : "");
-    r.add(sec, "max", *hi * scale, unit);
-    r.add_integer(sec, "values", static_cast<std::int64_t>(st.values.size()), "",
-                  "including the zero-strain reference");
-  }
-  if (s.stress) {
-    const StressSpec& st = *s.stress;
-    const std::string sec = "stress";
-    describe_axes(st, sec, r);
-    r.add_text(sec, "loading", st.loading == StressLoading::one_face ? "one_face" : "both_faces",
-               st.loading == StressLoading::one_face
-                   ? "lower face fixed, traction on the upper face"
-                   : "opposite tractions on both faces, nothing fixed");
-    const auto [lo, hi] = std::minmax_element(st.values.begin(), st.values.end());
-    r.add(sec, "min", *lo, "Pa", st.kind == LoadKind::compression ? "compression is negative" : "");
-    r.add(sec, "max", *hi, "Pa");
-    const Eigen::Vector3d& L = s.geometry.box_lengths;
-    const int a = (st.normal + 1) % 3;
-    const int b = (st.normal + 2) % 3;
-    r.add(sec, "loaded_face_area", L[a] * L[b], "m^2", "initial area of the loaded face");
-    r.add_integer(sec, "values", static_cast<std::int64_t>(st.values.size()), "",
-                  "including the zero-stress reference");
-  }
 }
 
 void describe_solver(const MessSpec& s, app::InfoReport& r) {
@@ -329,7 +274,7 @@ void describe_memory(const MessSpec& s, app::InfoReport& r) {
 }  // namespace
 
 void describe_mess(const MessSpec& s, app::InfoReport& r) {
-  r.add_text("mess", "run_type", run_type_name(s.run_type));
+  r.add_text("mess", "run_type", s.run_type);
   r.add_integer("mess", "relaxations", static_cast<std::int64_t>(s.relaxation_count()), "",
                 s.load_step_count() > 1 ? fmt::format("{} fields x {} load values",
                                                       s.field.values.size(), s.load_step_count())
@@ -340,7 +285,7 @@ void describe_mess(const MessSpec& s, app::InfoReport& r) {
   describe_scales(s, r);
   describe_particles(s, r);
   describe_field(s, r);
-  describe_loads(s, r);
+  s.protocol->describe(s, r);  // the protocol's own table, e.g. [strain]
   describe_solver(s, r);
   r.add_text("output", "node_positions", s.output.node_positions ? "on" : "off",
              s.output.node_positions

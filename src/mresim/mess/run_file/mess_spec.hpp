@@ -19,6 +19,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -33,19 +34,18 @@
 #include "mresim/mess/terms/energy_term.hpp"
 #include "mresim/mess/terms/magnetic_energy.hpp"
 
+namespace mresim::mess_protocol {
+class Protocol;
+}  // namespace mresim::mess_protocol
+
 namespace mresim::mess_config {
 
 // ---------------------------------------------------------------------------------------------
 // Run types
 
-enum class MessRunType { hysteresis, strain, magnetostriction, stress };
-
-// "mess_hysteresis", "mess_strain", "mess_magnetostriction", "mess_stress".
-std::string run_type_name(MessRunType type);
-// The four names above, in that order.
-const std::vector<std::string>& mess_run_type_names();
-// std::nullopt for any other name.
-std::optional<MessRunType> parse_run_type(std::string_view name);
+// The 3D run types are the registered protocols (protocols/protocol.hpp): one per
+// src/mresim/mess/protocols/*_protocol.cpp. Their names, sorted ("mess_hysteresis", ...).
+std::vector<std::string> mess_run_type_names();
 
 // ---------------------------------------------------------------------------------------------
 // [field]: the sequence of applied fields
@@ -209,8 +209,11 @@ inline constexpr double kMinRadius = 1e-30;
 inline constexpr double kMaxRadius = 1e30;
 
 struct MessSpec {
-  MessRunType run_type = MessRunType::hysteresis;
-  std::string title;  // [run].title
+  std::string run_type;  // [run].type, the protocol's name
+  std::string title;     // [run].title
+  // The protocol with its own table's settings (protocols/protocol.hpp); shared by copies of the
+  // spec (immutable).
+  std::shared_ptr<const mess_protocol::Protocol> protocol;
 
   // [model] profile: the table entry, read once here and passed down (never compared by name).
   const mess::ModelProfile* profile = &mess::model_profile("physical");
@@ -227,8 +230,6 @@ struct MessSpec {
   magnetism::SelfEnergyForm self_energy = magnetism::SelfEnergyForm::consistent;
 
   FieldSpec field;
-  std::optional<StrainSpec> strain;  // mess_strain only
-  std::optional<StressSpec> stress;  // mess_stress only
   SolverSpec solver;
   OutputSpec output;
 
@@ -243,7 +244,7 @@ struct MessSpec {
   // the system (MessSystem's constructor).
   std::vector<mess::TermSpec> terms;
 
-  // Load values (strain or stress; 1 for the other run types).
+  // Load values of the protocol (strain or stress; 1 for protocols without a load).
   std::size_t load_step_count() const;
   // Relaxations the run performs: fields x load values.
   std::size_t relaxation_count() const;

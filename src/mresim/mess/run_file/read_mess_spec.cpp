@@ -12,6 +12,7 @@
 
 #include "mresim/core/constants.hpp"
 #include "mresim/mess/lattice/stiffness.hpp"
+#include "mresim/mess/protocols/protocol.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
 
 namespace mresim::mess_config {
@@ -34,12 +35,6 @@ const std::vector<std::string> kPlacements{"regular",
                                            "chain",
                                            "helix"};
 
-const std::vector<std::string> kAxes{"x", "y", "z"};
-
-int axis_index(const std::string& name) {
-  return static_cast<int>(std::find(kAxes.begin(), kAxes.end(), name) - kAxes.begin());
-}
-
 // The table reader returns vectors as plain arrays (config/ does not depend on Eigen).
 Eigen::Vector3d to_vector(const std::array<double, 3>& v) { return {v[0], v[1], v[2]}; }
 std::optional<Eigen::Vector3d> to_vector(const std::optional<std::array<double, 3>>& v) {
@@ -52,8 +47,6 @@ std::vector<Eigen::Vector3d> to_vectors(const std::vector<std::array<double, 3>>
   for (const auto& v : list) out.push_back(to_vector(v));
   return out;
 }
-
-std::string quoted(std::string_view s) { return fmt::format("\"{}\"", s); }
 
 // The value as written, or `fallback` (a default) when the key is absent.
 std::string text_or(const TableReader& t, std::string_view key, const std::string& fallback) {
@@ -428,7 +421,7 @@ void read_particles(const TableReader& root, MessSpec& s) {
 
 // ------------------------------------------------------------------------------------ [field]
 
-void read_field(const TableReader& root, MessRunType type, FieldSpec& f) {
+void read_field(const TableReader& root, FieldSequence default_sequence, FieldSpec& f) {
   const TableReader t = root.table("field");
   const bool has_max = t.has("max");
   const bool has_steps = t.has("steps");
@@ -441,8 +434,6 @@ void read_field(const TableReader& root, MessRunType type, FieldSpec& f) {
   const auto values = t.optional_vector3_list("values", Range::any(), "T", 1);
   const auto theta = t.optional_number("theta", Range::between(0.0, 180.0), "deg");
   const auto phi = t.optional_number("phi", Range::between(-360.0, 360.0), "deg");
-  const FieldSequence default_sequence =
-      type == MessRunType::hysteresis ? FieldSequence::loop : FieldSequence::up;
   const FieldSequence sequence = t.enumeration_or(
       "sequence", default_sequence, {{"loop", FieldSequence::loop}, {"up", FieldSequence::up}});
 
@@ -520,149 +511,6 @@ void read_field(const TableReader& root, MessRunType type, FieldSpec& f) {
   for (const double b : applied) f.values.push_back(field_vector(b, f.theta_deg, f.phi_deg));
 }
 
-// ------------------------------------------------------------------------ [strain], [stress]
-
-struct LoadAxes {
-  int normal = 2;
-  int direction = 0;
-};
-
-LoadAxes read_axes(const TableReader& t, LoadKind kind) {
-  LoadAxes axes;
-  const std::string normal = t.choice_or("normal", "z", kAxes);
-  axes.normal = axis_index(normal);
-  if (kind == LoadKind::shear) {
-    const std::string direction = t.choice_or("direction", "x", kAxes);
-    axes.direction = axis_index(direction);
-    if (axes.direction == axes.normal) {
-      t.fail("direction", text_or(t, "direction", "\"x\" (default)"),
-             fmt::format("must differ from {} = \"{}\": shear moves the face normal to {} along "
-                         "direction",
-                         t.path("normal"), normal, t.path("normal")));
-    }
-    return axes;
-  }
-  axes.direction = axes.normal;
-  if (!t.has("direction")) return axes;
-  if (kind == LoadKind::torsion) {
-    t.fail("direction", t.value_text("direction"),
-           fmt::format("torsion twists the face normal to {} about that axis; give no "
-                       "direction (the sign of the angle sets the sense)",
-                       t.path("normal")));
-  }
-  const std::string direction = t.choice("direction", kAxes);
-  if (axis_index(direction) != axes.normal) {
-    t.fail("direction", t.value_text("direction"),
-           fmt::format("{} acts along the normal {} = \"{}\"; leave direction out or set it "
-                       "to \"{}\"",
-                       to_string(kind), t.path("normal"), normal, normal));
-  }
-  return axes;
-}
-
-// max and steps, or values; the list starts at 0 (the reference state at each field).
-std::vector<double> read_load_values(const TableReader& t, const Range& max_range,
-                                     const Range& value_range, const std::string& unit,
-                                     const std::string& what) {
-  const bool has_max = t.has("max");
-  const bool has_steps = t.has("steps");
-  const bool has_values = t.has("values");
-  const auto max = t.optional_number("max", max_range, unit);
-  const long steps = t.integer_or("steps", 0, Range::between(1, 10000));
-  const auto values = t.optional_number_list("values", value_range, unit, 1);
-  if (has_values && (has_max || has_steps)) {
-    t.fail("values", t.value_text("values"),
-           fmt::format("give either {0}.values or {0}.max and {0}.steps, not both", t.path()));
-  }
-  if (has_values) {
-    if (values->front() != 0.0) {
-      t.fail("values", t.value_text("values"),
-             fmt::format("must start with 0: the zero-{} state at each field is the reference "
-                         "of the loaded ones (Section 4.2.7)",
-                         what));
-    }
-    return *values;
-  }
-  if (!has_max) {
-    needed(t, "max",
-           fmt::format("give {0}.max and {0}.steps, or {0}.values = [0, ...]{1}", t.path(),
-                       unit.empty() ? "" : fmt::format(" ({})", unit)));
-  }
-  if (!has_steps) {
-    needed(t, "steps",
-           fmt::format("{}.max needs {}.steps, the number of increments from 0 to max "
-                       "(integer >= 1)",
-                       t.path(), t.path()));
-  }
-  std::vector<double> out;
-  for (long i = 0; i <= steps; ++i) {
-    out.push_back(*max * static_cast<double>(i) / static_cast<double>(steps));
-  }
-  return out;
-}
-
-LoadKind parse_kind(const std::string& name) {
-  if (name == "shear") return LoadKind::shear;
-  if (name == "tension") return LoadKind::tension;
-  if (name == "compression") return LoadKind::compression;
-  return LoadKind::torsion;
-}
-
-StrainSpec read_strain(const TableReader& root) {
-  const TableReader t = root.table("strain");
-  StrainSpec s;
-  s.kind = parse_kind(t.choice("kind", {"shear", "tension", "compression", "torsion"}));
-  const LoadAxes axes = read_axes(t, s.kind);
-  s.normal = axes.normal;
-  s.direction = axes.direction;
-  if (s.kind == LoadKind::shear) {
-    s.boundary = t.choice_or("boundary", "all_faces", {"all_faces", "normal_faces"}) == "all_faces"
-                     ? ShearBoundary::all_faces
-                     : ShearBoundary::normal_faces;
-  } else if (t.has("boundary")) {
-    t.fail("boundary", t.value_text("boundary"), "only read with strain.kind = \"shear\"");
-  }
-  switch (s.kind) {
-    case LoadKind::shear:
-      s.values =
-          read_load_values(t, Range::open(0.0, 1.0), Range::open(-1.0, 1.0), "rad", "strain");
-      break;
-    case LoadKind::tension:
-    case LoadKind::compression:
-      // Magnitudes: compression is stored negative below.
-      s.values =
-          read_load_values(t, Range::open(0.0, 1.0), Range{0.0, 1.0, true, false}, "", "strain");
-      if (s.kind == LoadKind::compression) {
-        for (double& v : s.values) v = 0.0 - v;  // +0, not -0
-      }
-      break;
-    case LoadKind::torsion:
-      s.values = read_load_values(t, Range{0.0, 180.0, false, true}, Range::between(-180.0, 180.0),
-                                  "deg", "strain");
-      for (double& v : s.values) v *= kDegree;
-      break;
-  }
-  return s;
-}
-
-StressSpec read_stress(const TableReader& root) {
-  const TableReader t = root.table("stress");
-  StressSpec s;
-  s.kind = parse_kind(t.choice("kind", {"shear", "tension", "compression"}));
-  const LoadAxes axes = read_axes(t, s.kind);
-  s.normal = axes.normal;
-  s.direction = axes.direction;
-  s.loading = t.choice_or("loading", "one_face", {"one_face", "both_faces"}) == "one_face"
-                  ? StressLoading::one_face
-                  : StressLoading::both_faces;
-  const Range values = s.kind == LoadKind::shear ? Range::any() : Range::non_negative();
-  s.values = read_load_values(t, Range::positive(), values, "Pa", "stress");
-  if (s.kind == LoadKind::compression) {
-    for (double& v : s.values) v = 0.0 - v;  // +0, not -0
-  }
-  return s;
-}
-
 // ----------------------------------------------------------------------------------- [solver]
 
 void read_solver(const std::optional<TableReader>& solver, bool demagnetization, SolverSpec& s) {
@@ -717,8 +565,6 @@ constexpr double kHeadroom = 1e10;
 constexpr double kMaxSaturation = 1e12;
 // Fields up to this (T) are lab fields: past kMaxSaturation with one, chi0 is blamed instead.
 constexpr double kLabField = 1e3;
-// The largest |stress| in units of model.youngs_modulus (check_load_scales).
-constexpr double kMaxStressOverModulus = 10.0;
 
 // The largest force scale whose squares summed over `coordinates` stay finite (header above).
 double largest_scale(double coordinates) {
@@ -785,27 +631,7 @@ void check_load_scales(const TableReader& root, const MessSpec& s, double top, d
                             "fields are below 100 T)",
                             b_limit, why));
   }
-  if (!s.stress) return;
-  double sigma = 0.0;
-  for (const double v : s.stress->values) sigma = std::max(sigma, std::abs(v));
-  const double overflow_limit = std::min(top / (l_e * l_e), top * elastic / (l_e * l_e));
-  const double strain_limit = kMaxStressOverModulus * s.lattice.youngs_modulus;
-  if (!(sigma <= overflow_limit)) {
-    refuse_load(root.table("stress"),
-                fmt::format("the largest stress must be <= {:.3g} Pa: beyond it the traction "
-                            "force on a face node (~ stress x l_e^2, l_e = {:.3g} m) is too "
-                            "large for the solvers' sums over the {} nodes to stay finite "
-                            "doubles (the polymer's modulus is of order 1e4 Pa)",
-                            std::min(overflow_limit, strain_limit), l_e, s.geometry.node_count()));
-  }
-  if (!(sigma <= strain_limit)) {
-    refuse_load(root.table("stress"),
-                fmt::format("the largest stress must be <= {:g} x model.youngs_modulus = {:.6g} "
-                            "Pa: beyond it the engineering strain (~ stress/E) exceeds {:g}, far "
-                            "outside the lattice's small-strain springs, and the relaxation does "
-                            "not converge",
-                            kMaxStressOverModulus, strain_limit, kMaxStressOverModulus));
-  }
+  s.protocol->check_scales(root, s, top, elastic);  // the load's own scales (mess_stress)
 }
 
 // Elastic force scale k_eff l_e (the seed's characteristic spring force, docs/lattice.md) and
@@ -886,33 +712,7 @@ std::optional<double> leapfrog_stability_limit(int discretization_order) {
   }
 }
 
-std::string run_type_name(MessRunType type) {
-  switch (type) {
-    case MessRunType::hysteresis:
-      return "mess_hysteresis";
-    case MessRunType::strain:
-      return "mess_strain";
-    case MessRunType::magnetostriction:
-      return "mess_magnetostriction";
-    case MessRunType::stress:
-      return "mess_stress";
-  }
-  return {};
-}
-
-const std::vector<std::string>& mess_run_type_names() {
-  static const std::vector<std::string> names{"mess_hysteresis", "mess_strain",
-                                              "mess_magnetostriction", "mess_stress"};
-  return names;
-}
-
-std::optional<MessRunType> parse_run_type(std::string_view name) {
-  for (const MessRunType t : {MessRunType::hysteresis, MessRunType::strain,
-                              MessRunType::magnetostriction, MessRunType::stress}) {
-    if (run_type_name(t) == name) return t;
-  }
-  return std::nullopt;
-}
+std::vector<std::string> mess_run_type_names() { return mess_protocol::protocol_names(); }
 
 std::string to_string(LoadKind kind) {
   switch (kind) {
@@ -960,45 +760,21 @@ Eigen::Vector3d field_vector(double magnitude, double theta_deg, double phi_deg)
          Eigen::Vector3d(st * cos_deg(phi_deg), st * sin_deg(phi_deg), cos_deg(theta_deg));
 }
 
-std::size_t MessSpec::load_step_count() const {
-  if (strain) return strain->values.size();
-  if (stress) return stress->values.size();
-  return 1;
-}
+std::size_t MessSpec::load_step_count() const { return protocol->load_values().size(); }
 
 std::size_t MessSpec::relaxation_count() const { return field.values.size() * load_step_count(); }
 
 MessSpec read_mess_spec(const TableReader& root, std::string_view run_type) {
-  const auto type = parse_run_type(run_type);
-  if (!type) {
-    throw std::invalid_argument(
-        fmt::format("read_mess_spec: '{}' is not a 3D run type (mess_hysteresis, mess_strain, "
-                    "mess_magnetostriction, mess_stress)",
-                    run_type));
-  }
+  // std::invalid_argument for a name that is not a registered protocol (a programming error).
+  const mess_protocol::ProtocolType& type = mess_protocol::find_protocol(run_type);
   MessSpec s;
-  s.run_type = *type;
+  s.run_type = type.name;
   if (const auto run = root.optional_table("run")) s.title = run->string_or("title", "");
   read_model(root.optional_table("model"), s);
   read_particles(root, s);
-  read_field(root, s.run_type, s.field);
-
-  const std::string this_type = quoted(run_type);
-  if (s.run_type == MessRunType::strain) {
-    s.strain = read_strain(root);
-  } else if (root.has("strain")) {
-    root.fail("strain", root.value_text("strain"),
-              fmt::format("only read by [run] type = \"mess_strain\" (this is {})", this_type));
-  }
-  if (s.run_type == MessRunType::stress) {
-    s.stress = read_stress(root);
-  } else if (root.has("stress")) {
-    root.fail("stress", root.value_text("stress"),
-              fmt::format("only read by [run] type = \"mess_stress\" (this is {})", this_type));
-  }
-
-  // The optional energy terms' tables [terms.<name>] (terms/energy_term.hpp).
-  s.terms = mess::read_term_tables(root);
+  read_field(root, type.default_field_sequence, s.field);
+  // The protocol's own table(s), e.g. [strain] (protocols/*_protocol.cpp).
+  s.protocol = mess_protocol::read_protocol(root, run_type);
 
   read_solver(root.optional_table("solver"), s.demagnetization, s.solver);
   check_scales(root, s);

@@ -1,8 +1,10 @@
-// Run types of the 3D model (Chapter 4): mess_hysteresis, mess_strain, mess_magnetostriction,
-// mess_stress. One plan for all four: the run file's MessSpec says which protocol the
-// ProtocolRunner follows. Checkpoints go to the staging directory after every
+// Run types of the 3D model (Chapter 4): one per registered protocol (protocols/protocol.hpp,
+// which calls mess_run_type below). One plan for all: the run file's MessSpec holds the
+// protocol the ProtocolRunner follows. Checkpoints go to the staging directory after every
 // [output] checkpoint_every steps; `mresim resume` hands the interrupted staging directory back
 // to execute(), which continues from its checkpoint.
+
+#include "mresim/mess/runs/mess_runs.hpp"
 
 #include <fmt/format.h>
 
@@ -14,10 +16,10 @@
 #include "mresim/app/invalid_results.hpp"
 #include "mresim/app/run_type.hpp"
 #include "mresim/app/stop_signal.hpp"
-#include "mresim/mess/run_file/mess_spec.hpp"
 #include "mresim/mess/outputs/checkpoint.hpp"
 #include "mresim/mess/outputs/mess_outputs.hpp"
 #include "mresim/mess/protocols/protocol_runner.hpp"
+#include "mresim/mess/run_file/mess_spec.hpp"
 #include "mresim/pair/runs/pair_outputs.hpp"
 
 namespace mresim::mess_protocol {
@@ -108,20 +110,15 @@ class MessPlan final : public app::RunPlan {
   std::string input_name_;
 };
 
-app::RunType mess_run_type(const char* name, const char* summary) {
+}  // namespace
+}  // namespace mresim::mess_protocol
+
+namespace mresim::mess_runs {
+
+app::RunType mess_run_type(const std::string& name, const std::string& summary) {
   return {name, summary, [name](const config::TableReader& root) {
-            return std::make_unique<MessPlan>(root, name);
+            return std::make_unique<mess_protocol::MessPlan>(root, name);
           }};
 }
 
-const app::RunTypeRegistrar hysteresis(mess_run_type(
-    "mess_hysteresis", "3D lattice (MESS): field loop with all faces held (Chapter 4)"));
-const app::RunTypeRegistrar strain(mess_run_type(
-    "mess_strain", "3D lattice (MESS): shear, tension, compression or torsion; G_eff / E_eff"));
-const app::RunTypeRegistrar magnetostriction(mess_run_type(
-    "mess_magnetostriction", "3D lattice (MESS): field series with only the bottom face held"));
-const app::RunTypeRegistrar stress(mess_run_type(
-    "mess_stress", "3D lattice (MESS): applied shear, tension or compression stress"));
-
-}  // namespace
-}  // namespace mresim::mess_protocol
+}  // namespace mresim::mess_runs
