@@ -79,12 +79,12 @@ struct ContractState {
     const double l_e = lattice.element_length;
     positions = mt::perturbed(lattice.positions, 0.05 * l_e);
     applied_forces = mt::perturbed(Eigen::Matrix3Xd::Zero(3, positions.cols()), 1e-10, 11);
-    const Eigen::Index np = static_cast<Eigen::Index>(lattice.particle_count());
+    const auto np = static_cast<Eigen::Index>(lattice.particle_count());
     loose.resize(3, np);
     magnetizations.resize(3, np);
     for (Eigen::Index i = 0; i < np; ++i) {
       loose.col(i) = lattice.particle_centres[static_cast<std::size_t>(i)];
-      const double t = static_cast<double>(i);
+      const auto t = static_cast<double>(i);
       magnetizations.col(i) =
           particles.Ms * Eigen::Vector3d(0.2 * std::cos(t), 0.15 - 0.1 * t, 0.4 + 0.1 * t);
     }
