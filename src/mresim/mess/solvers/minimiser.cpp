@@ -184,16 +184,67 @@ bool wolfe_line_search(Objective& f, const Eigen::VectorXd& u, const Eigen::Vect
 
 // -------------------------------------------------------------------------------- L-BFGS
 
+// The L-BFGS memory: the last `size` steps s and gradient changes y, rho = 1/(s.y).
+class LbfgsMemory {
+ public:
+  using Preconditioner = std::function<Eigen::VectorXd(const Eigen::VectorXd&)>;
+
+  bool empty() const { return S_.empty(); }
+  void clear() {
+    S_.clear();
+    Y_.clear();
+    rho_.clear();
+  }
+
+  // Keeps the pair if it has positive curvature, dropping the oldest beyond `size`.
+  void add(Eigen::VectorXd s, Eigen::VectorXd y, int size) {
+    const double sy = s.dot(y);
+    if (!(sy > 1e-12 * y.squaredNorm() && sy > 0.0)) return;
+    S_.push_back(std::move(s));
+    Y_.push_back(std::move(y));
+    rho_.push_back(1.0 / sy);
+    if (static_cast<int>(S_.size()) > size) {
+      S_.pop_front();
+      Y_.pop_front();
+      rho_.pop_front();
+    }
+  }
+
+  // H g by the two-loop recursion (N&W Alg. 7.4), H0 = (s.y / y.P y) P.
+  Eigen::VectorXd times(const Eigen::VectorXd& g, const Preconditioner& P) const {
+    Eigen::VectorXd q = g;
+    std::vector<double> a(S_.size());
+    for (int i = static_cast<int>(S_.size()) - 1; i >= 0; --i) {
+      const auto k = static_cast<std::size_t>(i);
+      a[k] = rho_[k] * S_[k].dot(q);
+      q -= a[k] * Y_[k];
+    }
+    if (!S_.empty()) {
+      q = P(q) * (S_.back().dot(Y_.back()) / Y_.back().dot(P(Y_.back())));
+    } else {
+      q = P(q);
+    }
+    for (std::size_t k = 0; k < S_.size(); ++k) {
+      const double b = rho_[k] * Y_[k].dot(q);
+      q += (a[k] - b) * S_[k];
+    }
+    return q;
+  }
+
+ private:
+  std::deque<Eigen::VectorXd> S_;
+  std::deque<Eigen::VectorXd> Y_;
+  std::deque<double> rho_;
+};
+
 InnerResult run_lbfgs(Objective& f, Eigen::VectorXd& u, int budget, const MinimiserOptions& opt,
                       const RigidParticlePreconditioner* precondition, bool use_energy,
                       const std::function<bool(const Eigen::VectorXd&, double)>& converged) {
-  const auto P = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
+  const LbfgsMemory::Preconditioner P = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
     return precondition != nullptr ? precondition->apply(v) : v;
   };
   InnerResult r;
-  std::deque<Eigen::VectorXd> S;
-  std::deque<Eigen::VectorXd> Y;
-  std::deque<double> rho;
+  LbfgsMemory memory;
   LinePoint cur;
   cur.phi = f(u, cur.g);
   if (!std::isfinite(cur.phi)) {
@@ -209,29 +260,10 @@ InnerResult run_lbfgs(Objective& f, Eigen::VectorXd& u, int budget, const Minimi
   int stalled = 0;
   double best_gradient = cur.g.cwiseAbs().maxCoeff();
   while (r.iterations < budget) {
-    // Two-loop recursion (N&W Alg. 7.4), H0 = (s.y / y.P y) P.
-    Eigen::VectorXd q = cur.g;
-    std::vector<double> a(S.size());
-    for (int i = static_cast<int>(S.size()) - 1; i >= 0; --i) {
-      const auto k = static_cast<std::size_t>(i);
-      a[k] = rho[k] * S[k].dot(q);
-      q -= a[k] * Y[k];
-    }
-    if (!S.empty()) {
-      q = P(q) * (S.back().dot(Y.back()) / Y.back().dot(P(Y.back())));
-    } else {
-      q = P(q);
-    }
-    for (std::size_t k = 0; k < S.size(); ++k) {
-      const double b = rho[k] * Y[k].dot(q);
-      q += (a[k] - b) * S[k];
-    }
-    Eigen::VectorXd d = -q;
+    Eigen::VectorXd d = -memory.times(cur.g, P);
     cur.dphi = cur.g.dot(d);
     if (!(cur.dphi < 0.0)) {  // not a descent direction: restart from steepest descent
-      S.clear();
-      Y.clear();
-      rho.clear();
+      memory.clear();
       d = -P(cur.g);
       cur.dphi = cur.g.dot(d);
     }
@@ -240,18 +272,16 @@ InnerResult run_lbfgs(Objective& f, Eigen::VectorXd& u, int budget, const Minimi
     // Without curvature information (no memory, no preconditioner) the first step is limited
     // to a tenth of max_step.
     const double alpha_init =
-        S.empty() && precondition == nullptr ? std::min(1.0, 0.1 * alpha_max) : 1.0;
+        memory.empty() && precondition == nullptr ? std::min(1.0, 0.1 * alpha_max) : 1.0;
     LinePoint next;
     const bool ok = wolfe_line_search(f, u, d, cur, alpha_init, alpha_max, use_energy, next);
     ++r.iterations;
     if (!ok) {
-      if (S.empty() || ++failures >= 2) {
+      if (memory.empty() || ++failures >= 2) {
         r.status = MinimiserStatus::line_search_failed;
         return r;
       }
-      S.clear();
-      Y.clear();
-      rho.clear();
+      memory.clear();
       continue;
     }
     failures = 0;
@@ -259,17 +289,7 @@ InnerResult run_lbfgs(Objective& f, Eigen::VectorXd& u, int budget, const Minimi
     Eigen::VectorXd y = next.g - cur.g;
     u += s;
     r.energy_change = next.phi - cur.phi;
-    const double sy = s.dot(y);
-    if (sy > 1e-12 * y.squaredNorm() && sy > 0.0) {
-      S.push_back(std::move(s));
-      Y.push_back(std::move(y));
-      rho.push_back(1.0 / sy);
-      if (static_cast<int>(S.size()) > opt.lbfgs_memory) {
-        S.pop_front();
-        Y.pop_front();
-        rho.pop_front();
-      }
-    }
+    memory.add(std::move(s), std::move(y), opt.lbfgs_memory);
     cur = std::move(next);
     // Stall guard: no energy decrease beyond rounding and no new smallest gradient for a while.
     const double gmax = cur.g.cwiseAbs().maxCoeff();
@@ -289,16 +309,47 @@ InnerResult run_lbfgs(Objective& f, Eigen::VectorXd& u, int budget, const Minimi
   return r;
 }
 
+// ------------------------------------------------------------------ evaluation rules
+
+// The minimiser's own evaluation rules, set on the system for the duration of one minimise()
+// call: where the particle centres are (CentreRule) and when M is re-solved
+// (MagnetizationUpdate). The caller's settings are kept here and written back whole when the
+// view goes out of scope, on return and on an exception alike, so minimise() leaves settings()
+// as it found them. Every change of rule during the call goes through this view.
+class RelaxationRules {
+ public:
+  explicit RelaxationRules(MessSystem& system) : system_(system), caller_(system.settings()) {}
+  RelaxationRules(const RelaxationRules&) = delete;
+  RelaxationRules& operator=(const RelaxationRules&) = delete;
+  RelaxationRules(RelaxationRules&&) = delete;
+  RelaxationRules& operator=(RelaxationRules&&) = delete;
+  ~RelaxationRules() { system_.settings() = caller_; }
+
+  const MessSettings& caller() const { return caller_; }
+  CentreRule centre_rule() const { return system_.settings().centre_rule; }
+  MagnetizationUpdate magnetization_update() const {
+    return system_.settings().magnetization_update;
+  }
+  void set_centre_rule(CentreRule rule) { system_.settings().centre_rule = rule; }
+  void set_magnetization_update(MagnetizationUpdate update) {
+    system_.settings().magnetization_update = update;
+  }
+
+ private:
+  MessSystem& system_;
+  const MessSettings caller_;
+};
+
 // --------------------------------------------------------------------------------- FIRE
 
 // Largest eigenvalue of M^-1 H (scaled units) by power iteration with finite-difference
 // Hessian-vector products; the magnetization stays fixed meanwhile. Returns
 // omega_max = sqrt(lambda_max).
-double estimate_omega_max(Objective& f, const Eigen::VectorXd& u, const Eigen::VectorXd& g0,
-                          const Eigen::VectorXd& inv_mass, int iterations) {
-  MessSettings& settings = f.system().settings();
-  const MagnetizationUpdate saved = settings.magnetization_update;
-  settings.magnetization_update = MagnetizationUpdate::manual;
+double estimate_omega_max(Objective& f, RelaxationRules& rules, const Eigen::VectorXd& u,
+                          const Eigen::VectorXd& g0, const Eigen::VectorXd& inv_mass,
+                          int iterations) {
+  const MagnetizationUpdate update = rules.magnetization_update();
+  rules.set_magnetization_update(MagnetizationUpdate::manual);
   std::mt19937_64 gen(12345);
   std::normal_distribution<double> normal;
   Eigen::VectorXd v(u.size());
@@ -317,13 +368,13 @@ double estimate_omega_max(Objective& f, const Eigen::VectorXd& u, const Eigen::V
     if (!(norm > 0.0)) break;
     v = w / norm;
   }
-  settings.magnetization_update = saved;
+  rules.set_magnetization_update(update);
   (void)f(u, g);  // back to the starting point
   return std::sqrt(std::max(lambda, 1e-300));
 }
 
-InnerResult run_fire(Objective& f, Eigen::VectorXd& u, int budget, const MinimiserOptions& opt,
-                     const Eigen::VectorXd& mass,
+InnerResult run_fire(Objective& f, RelaxationRules& rules, Eigen::VectorXd& u, int budget,
+                     const MinimiserOptions& opt, const Eigen::VectorXd& mass,
                      const std::function<bool(const Eigen::VectorXd&, double)>& converged) {
   const FireParameters& p = opt.fire;
   InnerResult r;
@@ -338,7 +389,7 @@ InnerResult run_fire(Objective& f, Eigen::VectorXd& u, int budget, const Minimis
     return r;
   }
   const Eigen::VectorXd inv_mass = mass.cwiseInverse();
-  const double omega = estimate_omega_max(f, u, g, inv_mass, p.power_iterations);
+  const double omega = estimate_omega_max(f, rules, u, g, inv_mass, p.power_iterations);
   const double dt_max = p.dt_max_factor / omega;
   double dt = p.dt_start_factor / omega;
   double alpha = p.alpha_start;
@@ -385,6 +436,155 @@ InnerResult run_fire(Objective& f, Eigen::VectorXd& u, int budget, const Minimis
   return r;
 }
 
+// ------------------------------------------------------------------------- outer loop
+
+// One minimise() call after its set-up: the inner minimisations (L-BFGS or FIRE), the phases
+// and fallbacks of the header between them, and the final report.
+class Minimisation {
+ public:
+  Minimisation(MessSystem& system, RelaxationRules& rules, const DofMap& map,
+               const MinimiserOptions& options, double force_scale, bool alternating)
+      : system_(system),
+        rules_(rules),
+        opt_(options),
+        force_scale_(force_scale),
+        measure_(system, map),
+        f_(system, map, force_scale),
+        u_(map.to_dofs(system.positions())),
+        // Nodal masses in units of m_c (FIRE only).
+        mass_(map.reduce_masses(system.lattice().masses) /
+              detail::characteristic_mass(system.lattice())),
+        alternating_(alternating),
+        budget_(options.max_iterations),
+        method_(options.method) {
+    if (options.precondition && options.method == MinimiserMethod::lbfgs) {
+      preconditioner_ = std::make_unique<RigidParticlePreconditioner>(system, map, force_scale);
+    }
+    res_.force_scale = force_scale;
+  }
+
+  // L-BFGS needs forces that are the potential's gradient. The seed's centre-voxel spreading is
+  // not quite (it differs by the particles' internal deformation), so L-BFGS first relaxes the
+  // conservative neighbour (centre = mean of all nodes, exact gradient); the seed's own forces
+  // are then checked, and FIRE (forces only) finishes if they exceed the tolerance.
+  MinimiserResult run() {
+    conservative_phase_ =
+        method_ == MinimiserMethod::lbfgs && caller_centre_rule() == CentreRule::centre_voxel;
+    if (conservative_phase_) rules_.set_centre_rule(CentreRule::all_nodes);
+    for (int outer = 0; outer < opt_.max_outer_iterations && budget_ > 0; ++outer) {
+      if (!outer_iteration()) break;
+    }
+    rules_.set_centre_rule(caller_centre_rule());
+    // Final state and report (M re-solved once more with every_evaluation).
+    evaluate_here();
+    res_.final = f_.last_evaluation();
+    res_.max_force = measure_.max_force(f_.full_gradient());
+    res_.evaluations = f_.evaluations();
+    res_.converged = res_.status == MinimiserStatus::converged;
+    return res_;
+  }
+
+ private:
+  CentreRule caller_centre_rule() const { return rules_.caller().centre_rule; }
+
+  void evaluate_here() {
+    Eigen::VectorXd g;
+    (void)f_(u_, g);
+  }
+
+  bool forces_below_tolerance() const {
+    return measure_.max_force(f_.full_gradient()) <= opt_.force_tolerance * force_scale_;
+  }
+
+  bool converged(double energy_change) const {
+    // Energy change relative to the potential's size, but never below the energy scale E0:
+    // tiny energies (a block at 1e-4 strain) are dominated by their own rounding noise.
+    return forces_below_tolerance() &&
+           std::abs(energy_change) <= opt_.energy_tolerance * std::max(f_.magnitude(), 1.0);
+  }
+
+  InnerResult run_inner() {
+    const auto test = [this](const Eigen::VectorXd& /*g*/, double energy_change) {
+      return converged(energy_change);
+    };
+    return method_ == MinimiserMethod::lbfgs
+               ? run_lbfgs(f_, u_, budget_, opt_, preconditioner_.get(), use_energy_, test)
+               : run_fire(f_, rules_, u_, budget_, opt_, mass_, test);
+  }
+
+  // One outer iteration; false ends the loop.
+  bool outer_iteration() {
+    if (alternating_ && system_.particle_count() > 0) {
+      (void)system_.solve_magnetization();
+      ++res_.outer_iterations;
+    }
+    const InnerResult inner = run_inner();
+    budget_ -= inner.iterations;
+    res_.iterations += inner.iterations;
+    res_.energy_change = inner.energy_change * f_.energy_scale();
+    res_.status = inner.status;
+    const bool failed = inner.status == MinimiserStatus::line_search_failed ||
+                        inner.status == MinimiserStatus::stalled;
+    if (failed && !alternating_ && system_.particle_count() > 0 &&
+        rules_.centre_rule() == CentreRule::all_nodes) {
+      // M(x) re-solved to a finite tolerance makes the reduced energy slightly rough; where
+      // that stalls the line search, continue at fixed M between re-solves.
+      alternating_ = true;
+      res_.switched_to_alternating = true;
+      rules_.set_magnetization_update(MagnetizationUpdate::manual);
+      return true;
+    }
+    if (conservative_phase_ && (failed || inner.status == MinimiserStatus::converged)) {
+      return end_conservative_phase(inner.status);
+    }
+    if (failed) {
+      if (method_ != MinimiserMethod::lbfgs) return false;
+      // Rounding or M-roughness L-BFGS cannot get through: FIRE needs forces only.
+      method_ = MinimiserMethod::fire;
+      res_.finished_with_fire = true;
+      return true;
+    }
+    if (inner.status != MinimiserStatus::converged) {
+      return inner.status == MinimiserStatus::max_iterations;
+    }
+    if (!alternating_ || system_.particle_count() == 0) return false;
+    // Re-solve M at the relaxed positions; done if the forces stay below the tolerance.
+    (void)system_.solve_magnetization();
+    evaluate_here();
+    if (forces_below_tolerance()) return false;
+    res_.status = MinimiserStatus::max_iterations;  // not yet: another outer iteration
+    return true;
+  }
+
+  // Back to the caller's centre rule (the seed's centre voxel); false if its forces are below
+  // the tolerance too, else L-BFGS continues on them with a slope-only line search.
+  bool end_conservative_phase(MinimiserStatus status) {
+    conservative_phase_ = false;
+    rules_.set_centre_rule(caller_centre_rule());
+    evaluate_here();
+    if (status == MinimiserStatus::converged && forces_below_tolerance()) return false;
+    use_energy_ = false;
+    res_.forces_only_phase = true;
+    return true;
+  }
+
+  MessSystem& system_;
+  RelaxationRules& rules_;
+  const MinimiserOptions& opt_;
+  double force_scale_;
+  const ForceMeasure measure_;
+  Objective f_;
+  Eigen::VectorXd u_;
+  const Eigen::VectorXd mass_;
+  std::unique_ptr<RigidParticlePreconditioner> preconditioner_;
+  MinimiserResult res_;
+  bool alternating_;
+  int budget_;
+  MinimiserMethod method_;
+  bool use_energy_ = true;
+  bool conservative_phase_ = false;
+};
+
 }  // namespace
 
 // --------------------------------------------------------------------------- minimise
@@ -395,117 +595,18 @@ MinimiserResult minimise(MessSystem& system, const MinimiserOptions& options) {
   const double force_scale = options.force_scale > 0.0
                                  ? options.force_scale
                                  : LeapfrogScales::of(system.lattice()).k_eff * l_e;
-  const MagnetizationUpdate saved_update = system.settings().magnetization_update;
-  bool alternating = options.coupling == MagnetizationCoupling::alternating;
-  system.settings().magnetization_update =
-      alternating ? MagnetizationUpdate::manual : MagnetizationUpdate::every_evaluation;
+  RelaxationRules rules(system);  // the caller's settings come back on every exit
+  const bool alternating = options.coupling == MagnetizationCoupling::alternating;
+  rules.set_magnetization_update(alternating ? MagnetizationUpdate::manual
+                                             : MagnetizationUpdate::every_evaluation);
   const MagnetizationStats stats0 = system.magnetization_stats();
 
   system.apply_constraints();
   const DofMap map(system.constraints(), system.positions(), l_e);
-  const ForceMeasure measure(system, map);
-  Objective f(system, map, force_scale);
-  Eigen::VectorXd u = map.to_dofs(system.positions());
-  // Nodal masses in units of m_c (FIRE only).
-  const Eigen::VectorXd mass =
-      map.reduce_masses(system.lattice().masses) / detail::characteristic_mass(system.lattice());
-
-  std::unique_ptr<RigidParticlePreconditioner> preconditioner;
-  if (options.precondition && options.method == MinimiserMethod::lbfgs) {
-    preconditioner = std::make_unique<RigidParticlePreconditioner>(system, map, force_scale);
-  }
-
-  MinimiserResult res;
-  res.force_scale = force_scale;
-  const auto converged = [&](const Eigen::VectorXd& /*g*/, double energy_change) {
-    const double force = measure.max_force(f.full_gradient());
-    // Energy change relative to the potential's size, but never below the energy scale E0:
-    // tiny energies (a block at 1e-4 strain) are dominated by their own rounding noise.
-    return force <= options.force_tolerance * force_scale &&
-           std::abs(energy_change) <= options.energy_tolerance * std::max(f.magnitude(), 1.0);
-  };
-
-  int budget = options.max_iterations;
-  MinimiserMethod method = options.method;
-  // L-BFGS needs forces that are the potential's gradient. The seed's centre-voxel spreading is
-  // not quite (it differs by the particles' internal deformation), so L-BFGS first relaxes the
-  // conservative neighbour (centre = mean of all nodes, exact gradient); the seed's own forces
-  // are then checked, and FIRE (forces only) finishes if they exceed the tolerance.
-  const CentreRule centre_rule = system.settings().centre_rule;
-  bool use_energy = true;
-  bool conservative_phase =
-      method == MinimiserMethod::lbfgs && centre_rule == CentreRule::centre_voxel;
-  if (conservative_phase) system.settings().centre_rule = CentreRule::all_nodes;
-  for (int outer = 0; outer < options.max_outer_iterations && budget > 0; ++outer) {
-    if (alternating && system.particle_count() > 0) {
-      (void)system.solve_magnetization();
-      ++res.outer_iterations;
-    }
-    const InnerResult inner =
-        method == MinimiserMethod::lbfgs
-            ? run_lbfgs(f, u, budget, options, preconditioner.get(), use_energy, converged)
-            : run_fire(f, u, budget, options, mass, converged);
-    budget -= inner.iterations;
-    res.iterations += inner.iterations;
-    res.energy_change = inner.energy_change * f.energy_scale();
-    res.status = inner.status;
-    const bool failed = inner.status == MinimiserStatus::line_search_failed ||
-                        inner.status == MinimiserStatus::stalled;
-    if (failed && !alternating && system.particle_count() > 0 &&
-        system.settings().centre_rule == CentreRule::all_nodes) {
-      // M(x) re-solved to a finite tolerance makes the reduced energy slightly rough; where
-      // that stalls the line search, continue at fixed M between re-solves.
-      alternating = true;
-      res.switched_to_alternating = true;
-      system.settings().magnetization_update = MagnetizationUpdate::manual;
-      continue;
-    }
-    if (conservative_phase && (failed || inner.status == MinimiserStatus::converged)) {
-      conservative_phase = false;
-      system.settings().centre_rule = centre_rule;
-      Eigen::VectorXd g;
-      (void)f(u, g);
-      if (inner.status == MinimiserStatus::converged &&
-          measure.max_force(f.full_gradient()) <= options.force_tolerance * force_scale) {
-        break;  // the seed's forces are below the tolerance too
-      }
-      use_energy = false;  // L-BFGS on the seed's forces, slope-only line search
-      res.forces_only_phase = true;
-      continue;
-    }
-    if (failed) {
-      if (method == MinimiserMethod::lbfgs) {
-        // Rounding or M-roughness L-BFGS cannot get through: FIRE needs forces only.
-        method = MinimiserMethod::fire;
-        res.finished_with_fire = true;
-        continue;
-      }
-      break;
-    }
-    if (inner.status != MinimiserStatus::converged) {
-      if (inner.status != MinimiserStatus::max_iterations) break;
-      continue;
-    }
-    if (!alternating || system.particle_count() == 0) break;
-    // Re-solve M at the relaxed positions; done if the forces stay below the tolerance.
-    (void)system.solve_magnetization();
-    Eigen::VectorXd g;
-    (void)f(u, g);
-    if (measure.max_force(f.full_gradient()) <= options.force_tolerance * force_scale) break;
-    res.status = MinimiserStatus::max_iterations;  // not yet: another outer iteration
-  }
-  system.settings().centre_rule = centre_rule;
-  // Final state and report (M re-solved once more with every_evaluation).
-  Eigen::VectorXd g;
-  (void)f(u, g);
-  res.final = f.last_evaluation();
-  res.max_force = measure.max_force(f.full_gradient());
-  res.evaluations = f.evaluations();
-  res.converged = res.status == MinimiserStatus::converged;
+  MinimiserResult res = Minimisation(system, rules, map, options, force_scale, alternating).run();
   const MagnetizationStats& stats = system.magnetization_stats();
   res.magnetization_solves = stats.solves - stats0.solves;
   res.unconverged_magnetization_solves = stats.unconverged - stats0.unconverged;
-  system.settings().magnetization_update = saved_update;
   return res;
 }
 

@@ -117,7 +117,17 @@ struct MinimiserResult {
 };
 
 // Relaxes system.positions() (free coordinates and rigid groups; held coordinates stay) and
-// its magnetizations. The system's MagnetizationUpdate is restored on return.
+// its magnetizations.
+//
+// Settings: system.settings() are the same on return as on entry, whether minimise() returns
+// or throws. While it runs, the system evaluates under the minimiser's own rules, set through
+// one scoped view (RelaxationRules in minimiser.cpp) that writes the caller's settings back
+// whole when the call ends: MagnetizationUpdate follows options.coupling (every_evaluation, or
+// manual for alternating and after the fallback to it; FIRE's frequency estimate holds M fixed),
+// and the seed's CentreRule::centre_voxel is replaced by all_nodes during the conservative
+// L-BFGS phase. The final state (positions, M, result.final) is at the caller's centre rule;
+// M was last re-solved under the coupling's rule, so with alternating it may differ from what the
+// caller's MagnetizationUpdate would give at the next evaluation.
 MinimiserResult minimise(MessSystem& system, const MinimiserOptions& options = {});
 
 // The convergence measure: max over free coordinates, rigid-group net forces and particle net
