@@ -106,7 +106,7 @@ std::shared_ptr<const Protocol> read_protocol(const config::TableReader& root,
       } else if (root.has(table) &&
                  std::find(own.tables.begin(), own.tables.end(), table) == own.tables.end()) {
         root.fail(table, root.value_text(table),
-                  fmt::format("only read by [run] type = \"{}\" (this is \"{}\")", t.name, name));
+                  fmt::format(R"(only read by [run] type = "{}" (this is "{}"))", t.name, name));
       }
     }
   }
