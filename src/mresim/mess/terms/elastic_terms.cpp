@@ -155,7 +155,7 @@ ElasticValue SpringKernel::evaluate(const lattice::Lattice& lat, const Eigen::Ma
     const double k_stretch = sp.stiffness[u] * stretch;
     return std::array<double, 2>{0.5 * k_stretch * stretch, std::abs(k_stretch) * l};
   });
-  if (!want_gradient) return {sums[0], sums[1]};
+  if (gradient == nullptr) return {sums[0], sums[1]};
     // Gather: every node sums its own springs in a fixed order (no races, no atomics).
 #pragma omp parallel for schedule(static) if (node_count_ >= detail::kParallelMinimum / 4)
   for (std::int64_t n = 0; n < node_count_; ++n) {
@@ -308,7 +308,7 @@ ElasticValue VolumeKernel::evaluate(const lattice::Lattice& lat, const Eigen::Ma
     }
     return std::array<double, 2>{0.5 * kappa * v0 * dv * dv, std::abs(kappa * v0 * dv)};
   });
-  if (want_gradient) gather(scratch_, *gradient);
+  if (gradient != nullptr) gather(scratch_, *gradient);
   return {sums[0], sums[1]};
 }
 
@@ -325,7 +325,8 @@ void VolumeKernel::add_hessian_product(const lattice::Lattice& lat, const Eigen:
         cell_hessian_terms(lattice::averaged_edge_vectors(gather_vertices(element, x)),
                            lattice::averaged_edge_vectors(gather_vertices(element, v)),
                            lat.polymer.kappa, v0, force_factor);
-    for (int k = 0; k < 3; ++k) Eigen::Map<Eigen::Vector3d>(scratch_.data() + 9 * c + 3 * k) = t[k];
+    for (int k = 0; k < 3; ++k)
+      Eigen::Map<Eigen::Vector3d>(scratch_.data() + 9 * c + 3 * std::int64_t{k}) = t[k];
   });
   gather(scratch_, out);
 }

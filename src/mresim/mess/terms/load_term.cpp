@@ -25,7 +25,8 @@ class LoadTerm final : public EnergyTerm {
     return {energy, 0.0};
   }
   HessianKind hessian_kind() const override { return HessianKind::zero; }
-  void add_hessian_product(const TermState&, const TermGradient&, TermGradient&) const override {}
+  void add_hessian_product(const TermState& /*state*/, const TermGradient& /*v*/,
+                           TermGradient& /*out*/) const override {}
 };
 
 const EnergyTermRegistrar registrar({.name = "load",

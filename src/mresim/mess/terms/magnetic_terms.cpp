@@ -19,7 +19,8 @@ namespace mm = mresim::magnetism;
 class CentreFreeTerm : public EnergyTerm {
  public:
   HessianKind hessian_kind() const override { return HessianKind::zero; }
-  void add_hessian_product(const TermState&, const TermGradient&, TermGradient&) const override {}
+  void add_hessian_product(const TermState& /*state*/, const TermGradient& /*v*/,
+                           TermGradient& /*out*/) const override {}
 };
 
 class ZeemanTerm final : public CentreFreeTerm {
