@@ -129,7 +129,8 @@ class EnergyTerm {
 
 // ------------------------------------------------------------------------------ registry
 
-// What a factory may use besides its own parameters. The references outlive the term.
+// What a factory may use besides its own parameters. Valid only during the factory call (the
+// system is moved and copied): a term copies what it keeps and reads the rest from TermState.
 struct TermContext {
   const lattice::Lattice& lattice;
   const magnetism::MagneticModel& model;
