@@ -775,6 +775,8 @@ MessSpec read_mess_spec(const TableReader& root, std::string_view run_type) {
   read_field(root, type.default_field_sequence, s.field);
   // The protocol's own table(s), e.g. [strain] (protocols/*_protocol.cpp).
   s.protocol = mess_protocol::read_protocol(root, run_type);
+  // The optional energy terms' tables [terms.<name>] (terms/energy_term.hpp).
+  s.terms = mess::read_term_tables(root);
 
   read_solver(root.optional_table("solver"), s.demagnetization, s.solver);
   check_scales(root, s);
