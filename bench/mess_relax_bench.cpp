@@ -123,7 +123,7 @@ void BM_Relax(benchmark::State& state) {
   const auto problem = static_cast<int>(state.range(0));
   const auto method = static_cast<Method>(state.range(1));
   Outcome o;
-  for (auto _ : state) o = relax(kProblems[problem], method);
+  for ([[maybe_unused]] auto _ : state) o = relax(kProblems[problem], method);
   state.counters["evaluations"] = static_cast<double>(o.evaluations);
   state.counters["converged"] = o.converged ? 1 : 0;
   state.SetLabel(std::string(kProblems[problem].name) + ", " + kMethodNames[method]);
@@ -144,11 +144,11 @@ class RatioReporter : public benchmark::ConsoleReporter {
   void Summarise() const {
     std::printf("\n== Summary (wall time, this run; states in units of l_e) ==\n");
     for (int p = 0; p < 3; ++p) {
-      const auto lf = find(p, leapfrog);
+      const auto* const lf = find(p, leapfrog);
       if (!lf) continue;
       std::printf("%s\n", kProblems[p].name);
       for (const Method m : {lbfgs, fire}) {
-        const auto t = find(p, m);
+        const auto* const t = find(p, m);
         if (!t) continue;
         const Outcome& a = g_outcomes.at({p, m});
         const Outcome& b = g_outcomes.at({p, leapfrog});

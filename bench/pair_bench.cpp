@@ -56,14 +56,15 @@ std::map<std::string, double> g_agreement;  // m, filled once per problem
 
 void BM_Fig22Loop(benchmark::State& state) {
   const auto method = static_cast<RelaxMethod>(state.range(0));
-  for (auto _ : state) benchmark::DoNotOptimize(run_hysteresis(fig22_pair(), sweep_with(method)));
+  for ([[maybe_unused]] auto _ : state)
+    benchmark::DoNotOptimize(run_hysteresis(fig22_pair(), sweep_with(method)));
   state.SetLabel(method == RelaxMethod::newton ? "newton" : "conjugate_gradient");
 }
 BENCHMARK(BM_Fig22Loop)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_Fig27Loop(benchmark::State& state) {
   const auto method = static_cast<RelaxMethod>(state.range(0));
-  for (auto _ : state) {
+  for ([[maybe_unused]] auto _ : state) {
     benchmark::DoNotOptimize(run_hysteresis(fig27_pair(), sweep_with(method, 10.0)));
   }
   state.SetLabel(method == RelaxMethod::newton ? "newton" : "conjugate_gradient");
@@ -88,7 +89,7 @@ void BM_Fig25Map(benchmark::State& state) {
   const int threads = static_cast<int>(state.range(1));
   omp_set_num_threads(threads);
   int hysteretic = 0;
-  for (auto _ : state) {
+  for ([[maybe_unused]] auto _ : state) {
     const CriticalFieldGrid grid = fig25_map(method);
     hysteretic = 0;
     for (const CriticalFields& f : grid.fields) hysteretic += f.hysteresis;
@@ -135,7 +136,8 @@ class RatioReporter : public benchmark::ConsoleReporter {
 
  private:
   void ratio(const char* what, const std::string& slow, const std::string& fast) const {
-    const auto s = seconds_.find(slow), f = seconds_.find(fast);
+    const auto s = seconds_.find(slow);
+    const auto f = seconds_.find(fast);
     if (s == seconds_.end() || f == seconds_.end()) return;
     std::printf("  %-40s conjugate gradients %.4f s / Newton %.4f s = %.1fx\n", what, s->second,
                 f->second, s->second / f->second);

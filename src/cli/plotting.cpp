@@ -96,7 +96,7 @@ bool has_plot_modules(const std::string& python) {
 // some interpreter works, so nothing is said then. Empty if none works, after the message, with
 // `failure_status` set: 127 if the interpreter does not exist, 1 if it lacks the modules.
 std::string plotting_interpreter(int& failure_status) {
-  const std::string python = python_interpreter();
+  std::string python = python_interpreter();
   if (has_plot_modules(python)) return python;
   const bool user_chose_python = std::getenv("MRESIM_PYTHON") != nullptr;
   if (!user_chose_python && python != kSystemPython && std::filesystem::exists(kSystemPython) &&
