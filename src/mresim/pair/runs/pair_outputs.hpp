@@ -52,7 +52,7 @@ void write_warnings_attribute(io::Hdf5File& h5, const std::vector<std::string>& 
 
 // The zero-field separation of the pair (m): the root of (k12 + k0/2)(S - S0) + dP/dS = 0
 // next to S0 (at B = 0 the moments vanish; the penalty may push the pair out of S0).
-double zero_field_separation(const PairSystem& system);
+double zero_field_separation(const PairSystem& p);
 
 // The warning for a separation S0 inside the WCA cut-off (empty when there is none): the
 // penalty pushes the pair out, so at zero field it sits at zero_field_separation(), not at S0.
