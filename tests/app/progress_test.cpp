@@ -74,6 +74,7 @@ TEST(Progress, UnknownTotalShowsACount) {
 TEST(Progress, CountsEveryUnitAcrossThreads) {
   Progress progress(8000, "threads", {nullptr, std::nullopt, 0.5});
   std::vector<std::thread> workers;
+  workers.reserve(8);
   for (int t = 0; t < 8; ++t) {
     workers.emplace_back([&] {
       for (int i = 0; i < 1000; ++i) progress.advance();

@@ -43,7 +43,7 @@ std::string refusal_of(const fs::path& target) {
 
 // A staging directory left by a killed run of pid `pid`, as RunDirectory creates them.
 fs::path interrupted_staging(const fs::path& final_dir, long pid) {
-  const fs::path staging =
+  fs::path staging =
       final_dir.parent_path() / (final_dir.filename().string() + ".partial-" + std::to_string(pid));
   fs::create_directories(staging);
   write_text(staging / RunDirectory::kOwnerFile, "mresim, pid " + std::to_string(pid));

@@ -28,7 +28,9 @@ TEST(MagnetismPortableNormalTest, EngineIsTheStandardMersenneTwister) {
 TEST(MagnetismPortableNormalTest, SampleMomentsAndRange) {
   mm::PortableNormal normal(42);
   const int n = 200000;
-  double sum = 0.0, sum_sq = 0.0, sum_cube = 0.0;
+  double sum = 0.0;
+  double sum_sq = 0.0;
+  double sum_cube = 0.0;
   int beyond_two_sd = 0;
   for (int i = 0; i < n; ++i) {
     const double x = normal.normal(0.35, 0.2);

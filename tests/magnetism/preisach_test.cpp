@@ -34,7 +34,9 @@ double expected_descending(double b) {
 // Expected coercive field: the zero of expected_descending, by bisection. Without the swap it
 // would be exactly 0.35 T; the swap moves it by ~6e-5 T to 0.35006 T.
 double expected_coercive_field() {
-  double lo = -1.0, hi = 0.0;  // expected_descending(lo) < 0 < expected_descending(hi)
+  // expected_descending(lo) < 0 < expected_descending(hi)
+  double lo = -1.0;
+  double hi = 0.0;
   for (int i = 0; i < 100; ++i) {
     const double mid = 0.5 * (lo + hi);
     (expected_descending(mid) > 0.0 ? hi : lo) = mid;
@@ -66,7 +68,8 @@ TEST(PreisachTest, RelayPopulationFollowsParameters) {
   const auto& alpha = model.up_switching_fields_t();
   const auto& beta = model.down_switching_fields_t();
   const auto& w = model.weights();
-  double alpha_sum = 0.0, beta_sum = 0.0;
+  double alpha_sum = 0.0;
+  double beta_sum = 0.0;
   for (std::size_t i = 0; i < model.relay_count(); ++i) {
     ASSERT_GE(alpha[i], beta[i]);
     alpha_sum += alpha[i];
@@ -160,11 +163,12 @@ TEST(PreisachTest, InitialStateIsDemagnetizedAndBalanced) {
   EXPECT_EQ(default_loop().m_over_ms.front(), model.magnetization());
 
   // Forced relays are in the zero-field state; bistable ones are mixed about half and half.
-  int bistable = 0, bistable_up = 0;
+  int bistable = 0;
+  int bistable_up = 0;
   for (std::size_t i = 0; i < model.relay_count(); ++i) {
     const double a = model.up_switching_fields_t()[i];
     const double b = model.down_switching_fields_t()[i];
-    const int s = model.states()[i];
+    const signed char s = model.states()[i];  // +1 up, -1 down
     if (a <= 0.0) {
       EXPECT_EQ(s, 1);
     } else if (b >= 0.0) {
@@ -209,14 +213,16 @@ TEST(PreisachTest, MajorLoopIsHystereticWithExpectedCoercivityAndRemanence) {
   EXPECT_GT(features.remanence, 0.5);
 
   // The whole descending branch follows the threshold distribution.
-  for (double b = -0.8; b <= 0.8; b += 0.1) {
+  for (int k = -8; k <= 8; ++k) {  // B = -0.8 ... 0.8 T (an integer counter: exact end)
+    const double b = 0.1 * k;
     EXPECT_NEAR(value_at(curve, mm::kBranchDown, b), expected_descending(b), 0.01) << b;
   }
 
   // Hysteresis: the branches differ by ~2 M_r at B = 0, and the final ascending branch is the
   // mirror image of the descending one (relays have mirror-symmetric distributions).
   EXPECT_GT(value_at(curve, mm::kBranchDown, 0.0) - value_at(curve, mm::kBranchUp, 0.0), 1.5);
-  for (double b = -0.8; b <= 0.8; b += 0.1) {
+  for (int k = -8; k <= 8; ++k) {
+    const double b = 0.1 * k;
     EXPECT_NEAR(value_at(curve, mm::kBranchUp, b), -expected_descending(-b), 0.01) << b;
   }
 }

@@ -21,7 +21,8 @@ PairSystem three_spring(PenaltyKind kind) {
 Eigen::Vector3d numeric_gradient(const PairEnergy& e, const Eigen::Vector3d& d, double h) {
   Eigen::Vector3d g;
   for (int i = 0; i < 3; ++i) {
-    Eigen::Vector3d p = d, m = d;
+    Eigen::Vector3d p = d;
+    Eigen::Vector3d m = d;
     p(i) += h;
     m(i) -= h;
     g(i) = (e.scaled_energy(p) - e.scaled_energy(m)) / (2.0 * h);
@@ -76,7 +77,8 @@ TEST(PairEnergyHessian, MatchesFiniteDifferencesOfTheGradient) {
     Eigen::Matrix3d numeric;
     const double h = 1e-7;
     for (int i = 0; i < 3; ++i) {
-      Eigen::Vector3d p = d, m = d;
+      Eigen::Vector3d p = d;
+      Eigen::Vector3d m = d;
       p(i) += h;
       m(i) -= h;
       numeric.col(i) = (energy.scaled_gradient(p) - energy.scaled_gradient(m)) / (2.0 * h);

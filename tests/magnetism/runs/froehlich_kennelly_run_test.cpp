@@ -83,7 +83,8 @@ TEST(FroehlichKennellyRun, WritesCurveToCsvAndHdf5) {
     plan->execute(dir.path(), results, progress);
     results.close();
   }
-  const std::size_t n = 100, samples = 5 * n + 1;
+  const std::size_t n = 100;
+  const std::size_t samples = 5 * n + 1;
 
   // summary.csv: header and one row per field value.
   std::istringstream csv(mresim::testing::read_text(dir / "summary.csv"));
@@ -95,7 +96,10 @@ TEST(FroehlichKennellyRun, WritesCurveToCsvAndHdf5) {
   ASSERT_EQ(rows.size(), samples);
   EXPECT_EQ(rows.front(), "0,0,0,0");
   const double m_max = fk_m_over_ms(0.5, 70, 1.6e6);  // 0.9457
-  double step = 0, branch = 0, b = 0, m = 0;
+  double step = 0;
+  double branch = 0;
+  double b = 0;
+  double m = 0;
   char comma = 0;
   std::istringstream(rows[n]) >> step >> comma >> branch >> comma >> b >> comma >> m;
   EXPECT_EQ(step, 100);

@@ -97,7 +97,8 @@ TEST(PreisachRun, WritesTheLoopOfPreisachLoop) {
     EXPECT_EQ(progress.done(), 151U);
     results.close();
   }
-  const std::size_t n = 30, samples = 5 * n + 1;
+  const std::size_t n = 30;
+  const std::size_t samples = 5 * n + 1;
   PreisachParameters p;
   p.relay_count = 20000;
   p.seed = 7;
