@@ -117,10 +117,20 @@ class Chapter4SmallRunsTest(unittest.TestCase):
         self.binary = find_mresim()
         if not knows_mess(self.binary):
             self.skipTest("this mresim has no mess_* run types")
-        self.tmp = tempfile.mkdtemp(prefix="mresim_chapter4_test_")
+        # MRESIM_EXAMPLE_RUNS=DIR keeps the runs in DIR (emptied first; CTest sets it to a folder
+        # of the build tree), where the C++ test of the examples' header promises reads them
+        # (chapter4_example_promises in CMakeLists.txt): each example then runs once per suite.
+        self.keep = os.environ.get("MRESIM_EXAMPLE_RUNS")
+        if self.keep:
+            shutil.rmtree(self.keep, ignore_errors=True)
+            os.makedirs(self.keep)
+            self.tmp = self.keep
+        else:
+            self.tmp = tempfile.mkdtemp(prefix="mresim_chapter4_test_")
 
     def tearDown(self):
-        shutil.rmtree(self.tmp, ignore_errors=True)
+        if not self.keep:
+            shutil.rmtree(self.tmp, ignore_errors=True)
 
     def assert_nontrivial_png(self, path):
         self.assertGreater(os.path.getsize(path), 15_000, path)
