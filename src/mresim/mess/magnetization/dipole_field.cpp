@@ -72,8 +72,10 @@ Eigen::MatrixXd DipoleCoupling::dense() const {
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
   for (std::size_t k = 0; k < pairs_.size(); ++k) {
     const ParticlePair& p = pairs_[k];
-    A.block<3, 3>(3 * p.i, 3 * p.j) += tensors_[k];
-    A.block<3, 3>(3 * p.j, 3 * p.i) += tensors_[k];
+    const Eigen::Index i = 3 * static_cast<Eigen::Index>(p.i);
+    const Eigen::Index j = 3 * static_cast<Eigen::Index>(p.j);
+    A.block<3, 3>(i, j) += tensors_[k];
+    A.block<3, 3>(j, i) += tensors_[k];
   }
   return A;
 }

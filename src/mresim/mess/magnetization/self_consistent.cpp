@@ -51,7 +51,8 @@ struct Problem {
           std::abs(r.data()[k]) / (options.atol + options.rtol * std::abs(m.data()[k]));
       if (!(ratio <= worst)) worst = ratio;  // NaN propagates as "worse"
     }
-    return std::isnan(worst) ? kInfinity : worst;
+    if (std::isnan(worst)) return kInfinity;
+    return worst;
   }
 
   // Magnetic energy over m in units of mu0 Ms^2 V: sum_i s(m_i) (eq. 4.76 [+ demag])
@@ -71,7 +72,8 @@ struct Problem {
   Eigen::MatrixXd hessian(const Eigen::Matrix3Xd& m) const {
     Eigen::MatrixXd H = -coupling.dense();
     for (int i = 0; i < n(); ++i) {
-      H.block<3, 3>(3 * i, 3 * i) +=
+      const Eigen::Index d = 3 * static_cast<Eigen::Index>(i);
+      H.block<3, 3>(d, d) +=
           particle_response_inverse_jacobian(m.col(i), chi, options.demagnetization);
     }
     return H;
@@ -143,8 +145,10 @@ void fixed_point(const Problem& p, Eigen::Matrix3Xd m, MagnetizationAttempt& att
 // Restarts from the best state when the residual grows a hundredfold.
 void anderson(const Problem& p, Eigen::Matrix3Xd m, MagnetizationAttempt& attempt, Best& best) {
   const Eigen::Index size = 3 * static_cast<Eigen::Index>(p.n());
-  std::deque<Eigen::VectorXd> df, dg;
-  Eigen::VectorXd f_prev, g_prev;
+  std::deque<Eigen::VectorXd> df;
+  std::deque<Eigen::VectorXd> dg;
+  Eigen::VectorXd f_prev;
+  Eigen::VectorXd g_prev;
   double smallest = kInfinity;  // of |f|_2 in this run
   for (int it = 0; it < p.options.max_anderson_iterations; ++it) {
     Eigen::Matrix3Xd g = p.map(m);
@@ -163,8 +167,8 @@ void anderson(const Problem& p, Eigen::Matrix3Xd m, MagnetizationAttempt& attemp
     }
     smallest = std::min(smallest, norm);
     if (f_prev.size() == size) {
-      df.push_back(f - f_prev);
-      dg.push_back(gv - g_prev);
+      df.emplace_back(f - f_prev);
+      dg.emplace_back(gv - g_prev);
       if (static_cast<int>(df.size()) > p.options.anderson_depth) {
         df.pop_front();
         dg.pop_front();
@@ -266,7 +270,7 @@ void newton(const Problem& p, Eigen::Matrix3Xd m, MagnetizationAttempt& attempt,
     const double slack = 1e-13 * (1.0 + std::abs(e0));
     double alpha = std::min(1.0, 0.99 * step_to_boundary(m, dm, kInside));
     bool accepted = false;
-    for (; alpha > 1e-14; alpha *= 0.5) {
+    while (!accepted && alpha > 1e-14) {
       const Eigen::Matrix3Xd trial = m + alpha * dm;
       const double e = p.energy(trial);
       const bool decrease =
@@ -274,7 +278,8 @@ void newton(const Problem& p, Eigen::Matrix3Xd m, MagnetizationAttempt& attempt,
       if (std::isfinite(e) && decrease) {
         m = trial;
         accepted = true;
-        break;
+      } else {
+        alpha *= 0.5;
       }
     }
     if (!accepted) return;

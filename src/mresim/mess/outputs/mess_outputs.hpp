@@ -54,6 +54,6 @@ std::vector<StepRecord> with_nan_for_non_finite(std::vector<StepRecord> records)
 // what is invalid; the caller warns and throws (runs/mess_runs.cpp).
 MessResultCheck write_mess_results(const std::filesystem::path& run_dir, io::Hdf5File& results,
                                    const ProtocolRunner& runner,
-                                   const std::vector<StepRecord>& records);
+                                   const std::vector<StepRecord>& computed);
 
 }  // namespace mresim::mess_protocol

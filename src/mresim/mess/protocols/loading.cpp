@@ -305,6 +305,8 @@ double measured_strain(const lattice::Lattice& lattice, const mess_config::Stres
   const double a = relative_slide(shape, normal, along, positions, reference);
   if (stress.kind != LoadKind::shear) return a;  // engineering strain along the normal
   if (stress.loading == mess_config::StressLoading::one_face) return std::atan(a);
+  // Pure shear: the slide of the `along` faces in the normal direction (the roles swap).
+  // NOLINTNEXTLINE(readability-suspicious-call-argument)
   const double b = relative_slide(shape, along, normal, positions, reference);
   return std::atan(a) + std::atan(b);
 }
