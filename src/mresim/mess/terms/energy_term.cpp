@@ -88,8 +88,10 @@ std::vector<TermSpec> read_term_tables(const config::TableReader& root) {
   const std::optional<config::TableReader> terms = root.optional_table("terms");
   if (!terms) return out;
   for (const TermRegistration& t : registry()) {
-    if (t.always_present || !terms->has(t.name)) continue;
-    out.push_back({t.name, t.read(terms->table(t.name))});
+    if (t.always_present) continue;
+    // optional_table() records the name as known, so a misspelt [terms.NAME] is refused with
+    // the registered names as the allowed ones.
+    if (const auto table = terms->optional_table(t.name)) out.push_back({t.name, t.read(*table)});
   }
   return out;
 }
