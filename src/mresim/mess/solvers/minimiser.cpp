@@ -10,13 +10,23 @@
 #include <stdexcept>
 
 #include "mresim/mess/solvers/leapfrog.hpp"
+#include "mresim/mess/solvers/line_search.hpp"
+#include "mresim/mess/solvers/newton.hpp"
 #include "mresim/mess/solvers/preconditioner.hpp"
 #include "mresim/mess/solvers/relaxation_common.hpp"
 
 namespace mresim::mess {
 
 std::string to_string(MinimiserMethod method) {
-  return method == MinimiserMethod::lbfgs ? "lbfgs" : "fire";
+  switch (method) {
+    case MinimiserMethod::lbfgs:
+      return "lbfgs";
+    case MinimiserMethod::fire:
+      return "fire";
+    case MinimiserMethod::newton:
+      return "newton";
+  }
+  return "unknown";
 }
 
 std::string to_string(MinimiserStatus status) {
@@ -46,6 +56,13 @@ void MinimiserOptions::validate() const {
   if (max_outer_iterations < 1) fail("max_outer_iterations must be >= 1");
   if (lbfgs_memory < 1) fail("lbfgs_memory must be >= 1");
   if (!(max_step > 0.0)) fail("max_step must be > 0");
+  if (newton.max_krylov_iterations < 1) fail("newton.max_krylov_iterations must be >= 1");
+  if (!(newton.forcing_max > 0.0 && newton.forcing_max < 1.0)) {
+    fail("newton.forcing_max must be in (0, 1)");
+  }
+  if (!(newton.amg.threshold >= 0.0) || newton.amg.smoothings < 0) {
+    fail("newton.amg parameters out of range");
+  }
   if (fire.n_min < 0 || !(fire.f_inc >= 1.0) || !(fire.f_dec > 0.0 && fire.f_dec < 1.0) ||
       !(fire.alpha_start > 0.0 && fire.alpha_start < 1.0) ||
       !(fire.f_alpha > 0.0 && fire.f_alpha <= 1.0) || !(fire.dt_max_factor > 0.0) ||
@@ -62,125 +79,10 @@ double max_free_force(const MessSystem& system, const Eigen::Matrix3Xd& gradient
 namespace {
 
 using detail::ForceMeasure;
+using detail::InnerResult;
+using detail::LinePoint;
 using detail::Objective;
-
-struct InnerResult {
-  MinimiserStatus status = MinimiserStatus::max_iterations;
-  int iterations = 0;
-  double energy_change = 0.0;  // scaled
-};
-
-// -------------------------------------------------------------------------- line search
-
-struct LinePoint {
-  double alpha = 0.0;
-  double phi = 0.0;   // scaled potential
-  double dphi = 0.0;  // directional derivative g . d
-  Eigen::VectorXd g;
-};
-
-// Strong-Wolfe line search (Nocedal & Wright Alg. 3.5/3.6) along d from u, with a rounding
-// slack on the sufficient-decrease test and derivative (secant) interpolation in the zoom.
-// On success `out` holds the accepted point and the system is left at it.
-// use_energy = false: forces only (a field that is not exactly a gradient): the energy tests
-// are dropped and the search brackets the zero of the slope g(alpha) . d.
-bool wolfe_line_search(Objective& f, const Eigen::VectorXd& u, const Eigen::VectorXd& d,
-                       LinePoint start, double alpha_init, double alpha_max, bool use_energy,
-                       LinePoint& out) {
-  start.alpha = 0.0;
-  constexpr double c1 = 1e-4;
-  constexpr double c2 = 0.9;
-  constexpr int kMaxTrials = 40;
-  const double slack = 64.0 * std::numeric_limits<double>::epsilon() * f.magnitude();
-  double last_alpha = 0.0;  // where the system was evaluated last
-  const auto eval = [&](double alpha) {
-    last_alpha = alpha;
-    LinePoint p;
-    p.alpha = alpha;
-    p.phi = f(u + alpha * d, p.g);
-    p.dphi = p.g.dot(d);
-    return p;
-  };
-  const auto armijo_fails = [&](const LinePoint& p) {
-    return !std::isfinite(p.phi) || !std::isfinite(p.dphi) ||
-           (use_energy && p.phi > start.phi + c1 * p.alpha * start.dphi + slack);
-  };
-  const auto higher = [&](const LinePoint& p, const LinePoint& than) {
-    return use_energy && p.phi > than.phi + slack;
-  };
-  const auto curvature_holds = [&](const LinePoint& p) {
-    return std::abs(p.dphi) <= -c2 * start.dphi;
-  };
-  int trials = 0;
-  // zoom(lo, hi): lo satisfies sufficient decrease, the minimiser lies between lo and hi.
-  const auto zoom = [&](LinePoint lo, LinePoint hi) {
-    while (trials < kMaxTrials) {
-      const double a = std::min(lo.alpha, hi.alpha);
-      const double b = std::max(lo.alpha, hi.alpha);
-      double alpha;
-      if (std::isfinite(hi.phi) && lo.dphi * hi.dphi < 0.0) {
-        alpha = lo.alpha - lo.dphi * (hi.alpha - lo.alpha) / (hi.dphi - lo.dphi);  // secant on phi'
-      } else {
-        alpha = 0.5 * (a + b);
-      }
-      alpha = std::clamp(alpha, a + 0.1 * (b - a), b - 0.1 * (b - a));
-      const LinePoint p = eval(alpha);
-      ++trials;
-      if (armijo_fails(p) || higher(p, lo)) {
-        hi = p;
-      } else {
-        if (curvature_holds(p)) {
-          out = p;
-          return true;
-        }
-        if (p.dphi * (hi.alpha - lo.alpha) >= 0.0) hi = lo;
-        lo = p;
-      }
-      if (std::abs(hi.alpha - lo.alpha) < 1e-12 * std::max(lo.alpha, hi.alpha)) break;
-    }
-    // Accept the best point with sufficient decrease if it made progress: lower energy beyond
-    // the noise, or a smaller slope.
-    if (lo.alpha > 0.0 && ((use_energy && lo.phi < start.phi - slack) ||
-                           std::abs(lo.dphi) < 0.5 * std::abs(start.dphi))) {
-      out = lo;
-      return true;
-    }
-    return false;
-  };
-
-  LinePoint prev = start;
-  double alpha = std::min(alpha_init, alpha_max);
-  bool ok = false;
-  while (trials < kMaxTrials) {
-    const LinePoint p = eval(alpha);
-    ++trials;
-    if (armijo_fails(p) || (prev.alpha > 0.0 && higher(p, prev))) {
-      ok = zoom(prev, p);
-      break;
-    }
-    if (curvature_holds(p)) {
-      out = p;
-      ok = true;
-      break;
-    }
-    if (p.dphi >= 0.0) {
-      ok = zoom(p, prev);
-      break;
-    }
-    if (alpha >= alpha_max) {  // cannot go further: accept the longest allowed step
-      out = p;
-      ok = true;
-      break;
-    }
-    prev = p;
-    alpha = std::min(2.0 * alpha, alpha_max);
-  }
-  if (ok && last_alpha != out.alpha) {
-    Eigen::VectorXd g;
-    (void)f(u + out.alpha * d, g);  // leave the system at the accepted point
-  }
-  return ok;
-}
+using detail::wolfe_line_search;
 
 // -------------------------------------------------------------------------------- L-BFGS
 
@@ -448,6 +350,7 @@ class Minimisation {
         rules_(rules),
         opt_(options),
         force_scale_(force_scale),
+        map_(map),
         measure_(system, map),
         f_(system, map, force_scale),
         u_(map.to_dofs(system.positions())),
@@ -457,7 +360,7 @@ class Minimisation {
         alternating_(alternating),
         budget_(options.max_iterations),
         method_(options.method) {
-    if (options.precondition && options.method == MinimiserMethod::lbfgs) {
+    if (options.precondition && options.method != MinimiserMethod::fire) {
       preconditioner_ = std::make_unique<RigidParticlePreconditioner>(system, map, force_scale);
     }
     res_.force_scale = force_scale;
@@ -469,7 +372,7 @@ class Minimisation {
   // are then checked, and FIRE (forces only) finishes if they exceed the tolerance.
   MinimiserResult run() {
     conservative_phase_ =
-        method_ == MinimiserMethod::lbfgs && caller_centre_rule() == CentreRule::centre_voxel;
+        method_ != MinimiserMethod::fire && caller_centre_rule() == CentreRule::centre_voxel;
     if (conservative_phase_) rules_.set_centre_rule(CentreRule::all_nodes);
     for (int outer = 0; outer < opt_.max_outer_iterations && budget_ > 0; ++outer) {
       if (!outer_iteration()) break;
@@ -480,6 +383,10 @@ class Minimisation {
     res_.final = f_.last_evaluation();
     res_.max_force = measure_.max_force(f_.full_gradient());
     res_.evaluations = f_.evaluations();
+    if (newton_ != nullptr) {
+      res_.krylov_iterations = newton_->krylov_iterations();
+      res_.preconditioner_seconds = newton_->preconditioner_seconds();
+    }
     res_.converged = res_.status == MinimiserStatus::converged;
     return res_;
   }
@@ -507,7 +414,14 @@ class Minimisation {
     const auto test = [this](const Eigen::VectorXd& /*g*/, double energy_change) {
       return converged(energy_change);
     };
-    return method_ == MinimiserMethod::lbfgs
+    // Newton needs an exact gradient: the seed's forces-only phase goes to L-BFGS.
+    if (method_ == MinimiserMethod::newton && use_energy_) {
+      if (newton_ == nullptr) {
+        newton_ = std::make_unique<detail::NewtonSolver>(system_, map_, force_scale_, opt_.newton);
+      }
+      return newton_->run(f_, u_, budget_, opt_, use_energy_, test);
+    }
+    return method_ != MinimiserMethod::fire
                ? run_lbfgs(f_, u_, budget_, opt_, preconditioner_.get(), use_energy_, test)
                : run_fire(f_, rules_, u_, budget_, opt_, mass_, test);
   }
@@ -538,7 +452,13 @@ class Minimisation {
       return end_conservative_phase(inner.status);
     }
     if (failed) {
-      if (method_ != MinimiserMethod::lbfgs) return false;
+      if (method_ == MinimiserMethod::fire) return false;
+      if (method_ == MinimiserMethod::newton && use_energy_) {
+        // Newton's line search failed twice in a row: L-BFGS continues from here.
+        method_ = MinimiserMethod::lbfgs;
+        res_.finished_with_lbfgs = true;
+        return true;
+      }
       // Rounding or M-roughness L-BFGS cannot get through: FIRE needs forces only.
       method_ = MinimiserMethod::fire;
       res_.finished_with_fire = true;
@@ -572,11 +492,13 @@ class Minimisation {
   RelaxationRules& rules_;
   const MinimiserOptions& opt_;
   double force_scale_;
+  const DofMap& map_;
   const ForceMeasure measure_;
   Objective f_;
   Eigen::VectorXd u_;
   const Eigen::VectorXd mass_;
   std::unique_ptr<RigidParticlePreconditioner> preconditioner_;
+  std::unique_ptr<detail::NewtonSolver> newton_;
   MinimiserResult res_;
   bool alternating_;
   int budget_;

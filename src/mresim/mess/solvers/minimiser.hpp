@@ -15,6 +15,8 @@
 //    derivative, so it keeps making progress where energy differences are below the energy's
 //    rounding error. Hand-written on Eigen: Debian's LBFGS++ (liblbfgspp-dev) would add a
 //    build dependency and lacks the preconditioned initial Hessian and the noise-tolerant search.
+//  - newton: Newton-Krylov with an algebraic-multigrid preconditioner (newton.hpp): outer
+//    iterations independent of the lattice size, cost per relaxation growing like N.
 //  - fire: the Fast Inertial Relaxation Engine (Bitzek et al., PRL 97, 170201 (2006)) with the
 //    semi-implicit Euler step and the uphill correction of FIRE 2.0 (Guenole et al., Comput.
 //    Mater. Sci. 175, 109584 (2020)), nodal masses as in the dynamics, dt_max from the highest
@@ -53,11 +55,12 @@
 #include <cstdint>
 #include <string>
 
+#include "mresim/mess/solvers/amg_preconditioner.hpp"
 #include "mresim/mess/system/system_energy.hpp"
 
 namespace mresim::mess {
 
-enum class MinimiserMethod { lbfgs, fire };
+enum class MinimiserMethod { lbfgs, fire, newton };
 enum class MagnetizationCoupling { alternating, every_evaluation };
 // stalled: 50 L-BFGS iterations without a new smallest force or an energy decrease beyond
 // rounding (the tolerance is below what the configuration's rounding allows).
@@ -80,6 +83,14 @@ struct FireParameters {
   int power_iterations = 30;
 };
 
+// Newton-Krylov (newton.hpp).
+struct NewtonOptions {
+  int max_krylov_iterations = 1000;  // CG iterations per Newton step
+  // CG's relative residual: min(forcing_max, sqrt(max |g|)) with g the scaled gradient.
+  double forcing_max = 0.1;
+  AmgOptions amg;
+};
+
 struct MinimiserOptions {
   MinimiserMethod method = MinimiserMethod::lbfgs;
   double force_tolerance = 1e-6;    // relative to force_scale
@@ -95,6 +106,7 @@ struct MinimiserOptions {
   bool precondition = true;
   double max_step = 0.2;  // largest coordinate change per iteration, in units of l_e
   FireParameters fire;
+  NewtonOptions newton;
 
   void validate() const;  // throws std::invalid_argument naming the option
 };
@@ -107,7 +119,10 @@ struct MinimiserResult {
   bool switched_to_alternating = false;   // every_evaluation fell back to alternating
   bool forces_only_phase = false;         // seed: L-BFGS continued on the seed's own forces
   bool finished_with_fire = false;        // lbfgs's line search failed; FIRE finished
+  bool finished_with_lbfgs = false;       // newton's line search failed; L-BFGS went on
   std::int64_t evaluations = 0;           // energy + gradient evaluations
+  std::int64_t krylov_iterations = 0;     // newton: CG iterations (Hessian products)
+  double preconditioner_seconds = 0.0;    // newton: building the multigrid
   double max_force = 0.0;                 // N, the convergence measure at the end
   double force_scale = 0.0;               // N
   double energy_change = 0.0;             // J, potential change over the last iteration

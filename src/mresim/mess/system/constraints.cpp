@@ -157,6 +157,24 @@ Eigen::VectorXd DofMap::reduce(const Eigen::Matrix3Xd& gradient) const {
   return g;
 }
 
+Eigen::Matrix3Xd DofMap::expand(const Eigen::VectorXd& v) const {
+  Eigen::Matrix3Xd x = Eigen::Matrix3Xd::Zero(3, static_cast<Eigen::Index>(dof_index_.size() / 3));
+  double* data = x.data();
+  const auto nc = static_cast<Eigen::Index>(coordinates_.size());
+  for (Eigen::Index k = 0; k < nc; ++k) data[coordinates_[static_cast<std::size_t>(k)]] = v[k];
+  for (Eigen::Index g = 0; g < groups(); ++g) {
+    const Eigen::Vector3d t = v.segment<3>(nc + 3 * g);
+    for (const std::int32_t n : group_nodes_[static_cast<std::size_t>(g)]) x.col(n) = t;
+  }
+  return x;
+}
+
+std::vector<std::uint8_t> DofMap::own_dof_mask() const {
+  std::vector<std::uint8_t> mask(dof_index_.size(), 0);
+  for (const std::int64_t c : coordinates_) mask[static_cast<std::size_t>(c)] = 1;
+  return mask;
+}
+
 Eigen::VectorXd DofMap::reduce_masses(const Eigen::VectorXd& masses) const {
   Eigen::VectorXd m(size());
   const auto nc = static_cast<Eigen::Index>(coordinates_.size());

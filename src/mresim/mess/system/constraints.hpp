@@ -74,6 +74,20 @@ class DofMap {
   void to_positions(const Eigen::VectorXd& u, Eigen::Matrix3Xd& x) const;
   // dE/du from dE/dx (3 x N).
   Eigen::VectorXd reduce(const Eigen::Matrix3Xd& gradient) const;
+  // The node direction (3 x N, units of l_e) that a change v of the dofs makes: free
+  // coordinates take their dof, group nodes their group's translation, held coordinates 0.
+  // reduce() is its transpose (times l_e).
+  Eigen::Matrix3Xd expand(const Eigen::VectorXd& v) const;
+  // Per coordinate 3 n + a: 1 if it is a dof of its own (free and outside every group).
+  std::vector<std::uint8_t> own_dof_mask() const;
+  // The flat coordinate 3 n + a of dof k, for k < size() - 3 groups().
+  std::int64_t coordinate_of(Eigen::Index k) const {
+    return coordinates_[static_cast<std::size_t>(k)];
+  }
+  Eigen::Index own_dofs() const { return static_cast<Eigen::Index>(coordinates_.size()); }
+  const std::vector<std::int32_t>& group_nodes(Eigen::Index g) const {
+    return group_nodes_[static_cast<std::size_t>(g)];
+  }
   // Masses per dof from nodal masses (a group's is the sum of its nodes').
   Eigen::VectorXd reduce_masses(const Eigen::VectorXd& masses) const;
   // The dof that moves coordinate a of node n: its own, its rigid group's translation

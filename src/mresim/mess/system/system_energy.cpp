@@ -1,5 +1,6 @@
 #include "mresim/mess/system/system_energy.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <stdexcept>
@@ -317,16 +318,73 @@ Eigen::Matrix3Xd MessSystem::hessian_product(const Eigen::Matrix3Xd& v) const {
 }
 
 Eigen::SparseMatrix<double> MessSystem::elastic_hessian() const {
-  return with_state([&](const TermState& state) {
-    std::vector<Eigen::Triplet<double>> entries;
+  std::vector<Eigen::Triplet<double>> entries;
+  TripletSink sink(entries);
+  add_elastic_hessian_blocks(sink);
+  const Eigen::Index n = 3 * lattice_.node_count();
+  Eigen::SparseMatrix<double> h(n, n);
+  h.setFromTriplets(entries.begin(), entries.end());
+  return h;
+}
+
+void MessSystem::add_elastic_hessian_blocks(HessianBlockSink& sink) const {
+  with_state([&](const TermState& state) {
     for (const auto& t : terms_) {
-      if (t->in_total() && t->has_hessian_entries()) t->add_hessian_entries(state, entries);
+      if (t->in_total() && t->has_hessian_entries()) t->add_hessian_blocks(state, sink);
     }
-    const Eigen::Index n = 3 * lattice_.node_count();
-    Eigen::SparseMatrix<double> h(n, n);
-    h.setFromTriplets(entries.begin(), entries.end());
-    return h;
+    return 0;
   });
+}
+
+Eigen::Matrix3Xd MessSystem::elastic_hessian_product(const Eigen::Matrix3Xd& v) const {
+  if (v.cols() != lattice_.node_count()) {
+    throw std::invalid_argument("MessSystem::elastic_hessian_product: expected " +
+                                std::to_string(lattice_.node_count()) + " columns");
+  }
+  return with_state([&](const TermState& state) {
+    const TermGradient direction{v, Eigen::Matrix3Xd::Zero(3, state.centres.cols())};
+    TermGradient out = TermGradient::zero(state);
+    for (const auto& t : terms_) {
+      if (t->in_total() && t->has_hessian_entries()) t->add_hessian_product(state, direction, out);
+    }
+    return Eigen::Matrix3Xd(out.nodes);
+  });
+}
+
+Eigen::MatrixXd MessSystem::reduced_centre_hessian() const {
+  const Eigen::Matrix3Xd c0 = particle_centres();
+  const Eigen::Index np = c0.cols();
+  Eigen::MatrixXd k = Eigen::MatrixXd::Zero(3 * np, 3 * np);
+  if (np == 0) return k;
+  mm::MagnetizationOptions options = settings_.magnetization;
+  options.demagnetization = model_.demagnetization;
+  options.atol = std::min(options.atol, 1e-13);
+  options.rtol = std::min(options.rtol, 1e-13);
+  const Eigen::Matrix3Xd history = has_history_ ? M_ : Eigen::Matrix3Xd(3, 0);
+  // The centre gradient of the centre terms at centres c, M solved there.
+  const auto centre_gradient_at = [&](const Eigen::Matrix3Xd& c) {
+    const mm::MagnetizationResult m =
+        mm::solve_magnetization(c, model_.particles, model_.applied_field, history, options);
+    const mm::PairList pairs = mm::OpenBoundary{}.pairs(c);
+    const TermState state{lattice_, positions_, c, m.M, model_, applied_forces_, settings_, pairs};
+    TermGradient g = TermGradient::zero(state);
+    for (const auto& t : terms_) {
+      if (t->in_total() && !t->has_hessian_entries()) (void)t->evaluate(state, &g);
+    }
+    return Eigen::Matrix3Xd(g.centres);
+  };
+  const double h = 1e-4 * lattice_.element_length;
+  for (Eigen::Index p = 0; p < np; ++p) {
+    for (int a = 0; a < 3; ++a) {
+      Eigen::Matrix3Xd plus = c0;
+      Eigen::Matrix3Xd minus = c0;
+      plus(a, p) += h;
+      minus(a, p) -= h;
+      const Eigen::Matrix3Xd difference = centre_gradient_at(plus) - centre_gradient_at(minus);
+      k.col(3 * p + a) = Eigen::Map<const Eigen::VectorXd>(difference.data(), 3 * np) / (2.0 * h);
+    }
+  }
+  return 0.5 * (k + k.transpose());
 }
 
 }  // namespace mresim::mess

@@ -168,6 +168,21 @@ class MessSystem {
   // The Hessian of the terms that have sparse entries (springs and volume, times their force
   // factors), 3N x 3N with row/column 3 n + a; held coordinates are not removed.
   Eigen::SparseMatrix<double> elastic_hessian() const;
+  // The same Hessian into any sink (e.g. a preallocated pattern, solvers/hessian_assembly.hpp).
+  void add_elastic_hessian_blocks(HessianBlockSink& sink) const;
+  // elastic_hessian() v without assembling it (J/m^2 x m; 3 x N), bitwise independent of the
+  // thread count.
+  Eigen::Matrix3Xd elastic_hessian_product(const Eigen::Matrix3Xd& v) const;
+
+  // The Hessian of the reduced energy E(x, M(x)) with respect to the particle centres
+  // (3 N_p x 3 N_p, J/m^2, row/column 3 p + a), of the terms that depend on the centres
+  // (dipole, WCA and the optional centre terms): central differences of their centre gradient
+  // with M re-solved, from the current M, at each shifted set of centres. By the envelope
+  // theorem that gradient is the reduced energy's, so this includes how M follows the
+  // centres, which hessian_product() (fixed M) leaves out. The solves use a tolerance near
+  // machine precision (whatever the settings say), so that the differences are not noise;
+  // step = 1e-4 l_e. Symmetrised. The system's state and statistics are not changed.
+  Eigen::MatrixXd reduced_centre_hessian() const;
 
  private:
   void maybe_update_magnetization();

@@ -203,24 +203,25 @@ void SpringKernel::add_hessian_product(const lattice::Lattice& lat, const Eigen:
   }
 }
 
-void SpringKernel::add_hessian_entries(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
-                                       std::vector<Eigen::Triplet<double>>& entries) {
+void SpringKernel::add_hessian_blocks(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
+                                      HessianBlockSink& sink) {
   const lattice::SpringSet& sp = lat.springs;
-  entries.reserve(entries.size() + 36 * sp.size());
   for (std::size_t s = 0; s < sp.size(); ++s) {
     const Eigen::Matrix3d block = spring_block(sp, s, x);
     const std::int64_t i = sp.first[s];
     const std::int64_t j = sp.second[s];
-    for (int a = 0; a < 3; ++a) {
-      for (int b = 0; b < 3; ++b) {
-        const double h = block(a, b);
-        entries.emplace_back(3 * i + a, 3 * i + b, h);
-        entries.emplace_back(3 * j + a, 3 * j + b, h);
-        entries.emplace_back(3 * i + a, 3 * j + b, -h);
-        entries.emplace_back(3 * j + a, 3 * i + b, -h);
-      }
-    }
+    sink.add(i, i, block);
+    sink.add(j, j, block);
+    sink.add(i, j, -block);
+    sink.add(j, i, -block);
   }
+}
+
+void SpringKernel::add_hessian_entries(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
+                                       std::vector<Eigen::Triplet<double>>& entries) {
+  entries.reserve(entries.size() + 36 * lat.springs.size());
+  TripletSink sink(entries);
+  add_hessian_blocks(lat, x, sink);
 }
 
 // ------------------------------------------------------------------------- VolumeKernel
@@ -331,32 +332,46 @@ void VolumeKernel::add_hessian_product(const lattice::Lattice& lat, const Eigen:
   gather(scratch_, out);
 }
 
-void VolumeKernel::add_hessian_entries(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
-                                       double force_factor,
-                                       std::vector<Eigen::Triplet<double>>& entries) {
+void VolumeKernel::add_hessian_blocks(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
+                                      double force_factor, HessianBlockSink& sink) {
   const double v0 = std::pow(lat.element_length, 3);
-  entries.reserve(entries.size() + 576 * lat.elements.size());
+  // The averaged edge vectors of each unit direction (vertex l, axis b): the same for every
+  // cell, as the edge averaging is linear.
+  std::array<lattice::EdgeVectors, 24> unit_edges;
+  for (int l = 0; l < 8; ++l) {
+    for (int b = 0; b < 3; ++b) {
+      lattice::CellVertices unit;
+      for (int k = 0; k < 8; ++k) unit[k] = Eigen::Vector3d::Zero();
+      unit[l][b] = 1.0;
+      unit_edges[static_cast<std::size_t>(3 * l + b)] = lattice::averaged_edge_vectors(unit);
+    }
+  }
+  Eigen::Matrix<double, 24, 24> cell;
   for (const auto& element : lat.elements) {
     const lattice::EdgeVectors e = lattice::averaged_edge_vectors(gather_vertices(element, x));
     // Column (l, b) of the cell's block: its product with the unit vector of that coordinate.
-    for (int l = 0; l < 8; ++l) {
-      for (int b = 0; b < 3; ++b) {
-        lattice::CellVertices unit;
-        for (int k = 0; k < 8; ++k) unit[k] = Eigen::Vector3d::Zero();
-        unit[l][b] = 1.0;
-        const std::array<Eigen::Vector3d, 3> t = cell_hessian_terms(
-            e, lattice::averaged_edge_vectors(unit), lat.polymer.kappa, v0, force_factor);
-        for (int k = 0; k < 8; ++k) {
-          const Eigen::Vector3d s = vertex_signs(k);
-          const Eigen::Vector3d column = s[0] * t[0] + s[1] * t[1] + s[2] * t[2];
-          for (int a = 0; a < 3; ++a) {
-            entries.emplace_back(3 * static_cast<std::int64_t>(element[k]) + a,
-                                 3 * static_cast<std::int64_t>(element[l]) + b, column[a]);
-          }
-        }
+    for (int column = 0; column < 24; ++column) {
+      const std::array<Eigen::Vector3d, 3> t = cell_hessian_terms(
+          e, unit_edges[static_cast<std::size_t>(column)], lat.polymer.kappa, v0, force_factor);
+      for (int k = 0; k < 8; ++k) {
+        const Eigen::Vector3d s = vertex_signs(k);
+        cell.block<3, 1>(3 * k, column) = s[0] * t[0] + s[1] * t[1] + s[2] * t[2];
+      }
+    }
+    for (int k = 0; k < 8; ++k) {
+      for (int l = 0; l < 8; ++l) {
+        sink.add(element[k], element[l], cell.block<3, 3>(3 * k, 3 * l));
       }
     }
   }
+}
+
+void VolumeKernel::add_hessian_entries(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
+                                       double force_factor,
+                                       std::vector<Eigen::Triplet<double>>& entries) {
+  entries.reserve(entries.size() + 576 * lat.elements.size());
+  TripletSink sink(entries);
+  add_hessian_blocks(lat, x, force_factor, sink);
 }
 
 // ------------------------------------------------------------------------- ElasticTerms

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "mresim/mess/lattice/lattice.hpp"
+#include "mresim/mess/terms/hessian_blocks.hpp"
 
 namespace mresim::mess {
 
@@ -95,7 +96,10 @@ class SpringKernel {
   // out += H v (all 3 x N).
   void add_hessian_product(const lattice::Lattice& lattice, const Eigen::Matrix3Xd& x,
                            const Eigen::Matrix3Xd& v, Eigen::Matrix3Xd& out) const;
-  // 36 entries per spring, rows/columns 3 n + a, in spring order.
+  // Four blocks per spring (B at (i, i) and (j, j), -B at (i, j) and (j, i)), in spring order.
+  static void add_hessian_blocks(const lattice::Lattice& lattice, const Eigen::Matrix3Xd& x,
+                                 HessianBlockSink& sink);
+  // The same as triplets: 36 entries per spring, rows/columns 3 n + a.
   static void add_hessian_entries(const lattice::Lattice& lattice, const Eigen::Matrix3Xd& x,
                                   std::vector<Eigen::Triplet<double>>& entries);
 
@@ -124,7 +128,10 @@ class VolumeKernel {
   void add_hessian_product(const lattice::Lattice& lattice, const Eigen::Matrix3Xd& x,
                            double force_factor, const Eigen::Matrix3Xd& v,
                            Eigen::Matrix3Xd& out) const;
-  // 576 entries per cell (its dense 24 x 24 block), in cell order.
+  // 64 blocks per cell (its dense 24 x 24 block), in cell order.
+  static void add_hessian_blocks(const lattice::Lattice& lattice, const Eigen::Matrix3Xd& x,
+                                 double force_factor, HessianBlockSink& sink);
+  // The same as triplets: 576 entries per cell.
   static void add_hessian_entries(const lattice::Lattice& lattice, const Eigen::Matrix3Xd& x,
                                   double force_factor,
                                   std::vector<Eigen::Triplet<double>>& entries);

@@ -38,8 +38,7 @@ void EnergyTerm::add_hessian_product(const TermState& state, const TermGradient&
   out.centres += (plus.centres - minus.centres) / (2.0 * h);
 }
 
-void EnergyTerm::add_hessian_entries(const TermState& /*state*/,
-                                     std::vector<Eigen::Triplet<double>>& /*entries*/) const {
+void EnergyTerm::add_hessian_blocks(const TermState& /*state*/, HessianBlockSink& /*sink*/) const {
   throw std::logic_error("EnergyTerm '" + std::string(name()) +
                          "': no sparse Hessian entries (only the elastic terms have them)");
 }

@@ -46,6 +46,7 @@
 #include "mresim/mess/lattice/lattice.hpp"
 #include "mresim/mess/magnetization/dipole_field.hpp"
 #include "mresim/mess/system/mess_settings.hpp"
+#include "mresim/mess/terms/hessian_blocks.hpp"
 #include "mresim/mess/terms/magnetic_energy.hpp"
 
 namespace mresim::mess {
@@ -117,14 +118,19 @@ class EnergyTerm {
   // the particle radius); terms with a cheap exact formula override it.
   virtual void add_hessian_product(const TermState& state, const TermGradient& v,
                                    TermGradient& out) const;
-  // Whether add_hessian_entries is available: the elastic terms (springs, volume), whose
+  // Whether add_hessian_blocks is available: the elastic terms (springs, volume), whose
   // Hessian is a sparse matrix over the node coordinates only.
   [[nodiscard]] virtual bool has_hessian_entries() const { return false; }
-  // ADDS force_factor times the Hessian's entries with respect to the node coordinates
-  // (row/column 3 n + a for coordinate a of node n; duplicates are summed by setFromTriplets).
-  // The default throws std::logic_error.
-  virtual void add_hessian_entries(const TermState& state,
-                                   std::vector<Eigen::Triplet<double>>& entries) const;
+  // ADDS force_factor times the Hessian with respect to the node coordinates to `sink`, as
+  // 3 x 3 node blocks (terms/hessian_blocks.hpp). The default throws std::logic_error.
+  virtual void add_hessian_blocks(const TermState& state, HessianBlockSink& sink) const;
+  // The same as triplets (row/column 3 n + a for coordinate a of node n; duplicates are
+  // summed by setFromTriplets).
+  void add_hessian_entries(const TermState& state,
+                           std::vector<Eigen::Triplet<double>>& entries) const {
+    TripletSink sink(entries);
+    add_hessian_blocks(state, sink);
+  }
 };
 
 // ------------------------------------------------------------------------------ registry

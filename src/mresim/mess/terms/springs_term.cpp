@@ -25,9 +25,8 @@ class SpringsTerm final : public EnergyTerm {
     kernel_.add_hessian_product(s.lattice, s.positions, v.nodes, out.nodes);
   }
   bool has_hessian_entries() const override { return true; }
-  void add_hessian_entries(const TermState& s,
-                           std::vector<Eigen::Triplet<double>>& entries) const override {
-    SpringKernel::add_hessian_entries(s.lattice, s.positions, entries);
+  void add_hessian_blocks(const TermState& s, HessianBlockSink& sink) const override {
+    SpringKernel::add_hessian_blocks(s.lattice, s.positions, sink);
   }
 
  private:

@@ -30,9 +30,8 @@ class VolumeTerm final : public EnergyTerm {
     kernel_.add_hessian_product(s.lattice, s.positions, force_factor(s), v.nodes, out.nodes);
   }
   bool has_hessian_entries() const override { return true; }
-  void add_hessian_entries(const TermState& s,
-                           std::vector<Eigen::Triplet<double>>& entries) const override {
-    VolumeKernel::add_hessian_entries(s.lattice, s.positions, force_factor(s), entries);
+  void add_hessian_blocks(const TermState& s, HessianBlockSink& sink) const override {
+    VolumeKernel::add_hessian_blocks(s.lattice, s.positions, force_factor(s), sink);
   }
 
  private:

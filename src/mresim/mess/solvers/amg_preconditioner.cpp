@@ -1,0 +1,124 @@
+#include "mresim/mess/solvers/amg_preconditioner.hpp"
+
+#include <petscksp.h>
+
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+
+namespace mresim::mess {
+
+namespace {
+
+void check(PetscErrorCode code, const char* what) {
+  if (code == 0) return;
+  const char* text = nullptr;
+  (void)PetscErrorMessage(code, &text, nullptr);
+  throw std::runtime_error(std::string("PETSc ") + what + ": " +
+                           (text != nullptr ? text : "error " + std::to_string(code)));
+}
+
+// Initialises PETSc (and MPI, as a singleton when the program was not started by mpirun) the
+// first time a preconditioner is built; finalised at exit. PETSc's errors are returned, not
+// printed, so that check() can report them.
+void ensure_petsc() {
+  static const bool initialised = [] {
+    PetscBool already = PETSC_FALSE;
+    check(PetscInitialized(&already), "PetscInitialized");
+    if (already == PETSC_FALSE) {
+      check(PetscInitializeNoArguments(), "PetscInitialize");
+      (void)std::atexit([] { (void)PetscFinalize(); });
+    }
+    check(PetscPushErrorHandler(PetscReturnErrorHandler, nullptr), "PetscPushErrorHandler");
+    return true;
+  }();
+  (void)initialised;
+}
+
+}  // namespace
+
+struct AmgPreconditioner::Impl {
+  Mat matrix = nullptr;
+  PC pc = nullptr;
+  Vec in = nullptr;
+  Vec out = nullptr;
+  PetscInt size = 0;
+
+  Impl() = default;
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+  Impl(Impl&&) = delete;
+  Impl& operator=(Impl&&) = delete;
+  ~Impl() {
+    (void)PCDestroy(&pc);
+    (void)VecDestroy(&in);
+    (void)VecDestroy(&out);
+    (void)MatDestroy(&matrix);
+  }
+};
+
+AmgPreconditioner::AmgPreconditioner(const ElasticMatrix& matrix,
+                                     const Eigen::Matrix3Xd& coordinates, const AmgOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  static_assert(sizeof(PetscInt) == sizeof(std::int32_t), "PETSc with 32-bit indices expected");
+  ensure_petsc();
+  Impl& p = *impl_;
+  p.size = matrix.rows();
+  if (coordinates.size() != p.size) {
+    throw std::invalid_argument("AmgPreconditioner: coordinates do not match the matrix");
+  }
+  // PETSc reads the arrays in place (no copy); it never writes them.
+  // NOLINTBEGIN(cppcoreguidelines-pro-type-const-cast)
+  check(MatCreateSeqAIJWithArrays(PETSC_COMM_SELF, p.size, p.size,
+                                  const_cast<PetscInt*>(matrix.row_start().data()),
+                                  const_cast<PetscInt*>(matrix.columns().data()),
+                                  const_cast<PetscScalar*>(matrix.values().data()), &p.matrix),
+        "MatCreateSeqAIJWithArrays");
+  // NOLINTEND(cppcoreguidelines-pro-type-const-cast)
+  check(MatSetBlockSize(p.matrix, 3), "MatSetBlockSize");
+  check(VecCreateSeqWithArray(PETSC_COMM_SELF, 3, p.size, nullptr, &p.in), "VecCreate");
+  check(VecCreateSeqWithArray(PETSC_COMM_SELF, 3, p.size, nullptr, &p.out), "VecCreate");
+
+  // The six rigid-body modes of the node positions as GAMG's near-null space.
+  Vec xyz = nullptr;
+  check(VecCreateSeqWithArray(PETSC_COMM_SELF, 3, p.size, coordinates.data(), &xyz), "VecCreate");
+  MatNullSpace modes = nullptr;
+  check(MatNullSpaceCreateRigidBody(xyz, &modes), "MatNullSpaceCreateRigidBody");
+  check(MatSetNearNullSpace(p.matrix, modes), "MatSetNearNullSpace");
+  (void)MatNullSpaceDestroy(&modes);
+  (void)VecDestroy(&xyz);
+
+  check(PCCreate(PETSC_COMM_SELF, &p.pc), "PCCreate");
+  check(PCSetOperators(p.pc, p.matrix, p.matrix), "PCSetOperators");
+  check(PCSetType(p.pc, PCGAMG), "PCSetType");
+  check(PCGAMGSetType(p.pc, PCGAMGAGG), "PCGAMGSetType");
+  check(PCGAMGSetNSmooths(p.pc, options.smoothings), "PCGAMGSetNSmooths");
+  PetscReal threshold = options.threshold;
+  check(PCGAMGSetThreshold(p.pc, &threshold, 1), "PCGAMGSetThreshold");
+  check(PCSetFromOptions(p.pc), "PCSetFromOptions");  // PETSC_OPTIONS may refine it
+  check(PCSetUp(p.pc), "PCSetUp (GAMG)");
+}
+
+AmgPreconditioner::AmgPreconditioner(AmgPreconditioner&&) noexcept = default;
+AmgPreconditioner& AmgPreconditioner::operator=(AmgPreconditioner&&) noexcept = default;
+AmgPreconditioner::~AmgPreconditioner() = default;
+
+void AmgPreconditioner::apply(const Eigen::VectorXd& in, Eigen::VectorXd& out) const {
+  Impl& p = *impl_;
+  if (in.size() != p.size) throw std::invalid_argument("AmgPreconditioner::apply: wrong size");
+  out.resize(p.size);
+  check(VecPlaceArray(p.in, in.data()), "VecPlaceArray");
+  check(VecPlaceArray(p.out, out.data()), "VecPlaceArray");
+  const PetscErrorCode code = PCApply(p.pc, p.in, p.out);
+  (void)VecResetArray(p.in);
+  (void)VecResetArray(p.out);
+  check(code, "PCApply");
+}
+
+int AmgPreconditioner::levels() const {
+  PetscInt levels = 0;
+  check(PCMGGetLevels(impl_->pc, &levels), "PCMGGetLevels");
+  return static_cast<int>(levels);
+}
+
+}  // namespace mresim::mess

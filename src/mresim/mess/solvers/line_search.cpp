@@ -1,0 +1,107 @@
+#include "mresim/mess/solvers/line_search.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace mresim::mess::detail {
+
+bool wolfe_line_search(Objective& f, const Eigen::VectorXd& u, const Eigen::VectorXd& d,
+                       LinePoint start, double alpha_init, double alpha_max, bool use_energy,
+                       LinePoint& out) {
+  start.alpha = 0.0;
+  constexpr double c1 = 1e-4;
+  constexpr double c2 = 0.9;
+  constexpr int kMaxTrials = 40;
+  const double slack = 64.0 * std::numeric_limits<double>::epsilon() * f.magnitude();
+  double last_alpha = 0.0;  // where the system was evaluated last
+  const auto eval = [&](double alpha) {
+    last_alpha = alpha;
+    LinePoint p;
+    p.alpha = alpha;
+    p.phi = f(u + alpha * d, p.g);
+    p.dphi = p.g.dot(d);
+    return p;
+  };
+  const auto armijo_fails = [&](const LinePoint& p) {
+    return !std::isfinite(p.phi) || !std::isfinite(p.dphi) ||
+           (use_energy && p.phi > start.phi + c1 * p.alpha * start.dphi + slack);
+  };
+  const auto higher = [&](const LinePoint& p, const LinePoint& than) {
+    return use_energy && p.phi > than.phi + slack;
+  };
+  const auto curvature_holds = [&](const LinePoint& p) {
+    return std::abs(p.dphi) <= -c2 * start.dphi;
+  };
+  int trials = 0;
+  // zoom(lo, hi): lo satisfies sufficient decrease, the minimiser lies between lo and hi.
+  const auto zoom = [&](LinePoint lo, LinePoint hi) {
+    while (trials < kMaxTrials) {
+      const double a = std::min(lo.alpha, hi.alpha);
+      const double b = std::max(lo.alpha, hi.alpha);
+      double alpha;
+      if (std::isfinite(hi.phi) && lo.dphi * hi.dphi < 0.0) {
+        alpha = lo.alpha - lo.dphi * (hi.alpha - lo.alpha) / (hi.dphi - lo.dphi);  // secant on phi'
+      } else {
+        alpha = 0.5 * (a + b);
+      }
+      alpha = std::clamp(alpha, a + 0.1 * (b - a), b - 0.1 * (b - a));
+      const LinePoint p = eval(alpha);
+      ++trials;
+      if (armijo_fails(p) || higher(p, lo)) {
+        hi = p;
+      } else {
+        if (curvature_holds(p)) {
+          out = p;
+          return true;
+        }
+        if (p.dphi * (hi.alpha - lo.alpha) >= 0.0) hi = lo;
+        lo = p;
+      }
+      if (std::abs(hi.alpha - lo.alpha) < 1e-12 * std::max(lo.alpha, hi.alpha)) break;
+    }
+    // Accept the best point with sufficient decrease if it made progress: lower energy beyond
+    // the noise, or a smaller slope.
+    if (lo.alpha > 0.0 && ((use_energy && lo.phi < start.phi - slack) ||
+                           std::abs(lo.dphi) < 0.5 * std::abs(start.dphi))) {
+      out = lo;
+      return true;
+    }
+    return false;
+  };
+
+  LinePoint prev = start;
+  double alpha = std::min(alpha_init, alpha_max);
+  bool ok = false;
+  while (trials < kMaxTrials) {
+    const LinePoint p = eval(alpha);
+    ++trials;
+    if (armijo_fails(p) || (prev.alpha > 0.0 && higher(p, prev))) {
+      ok = zoom(prev, p);
+      break;
+    }
+    if (curvature_holds(p)) {
+      out = p;
+      ok = true;
+      break;
+    }
+    if (p.dphi >= 0.0) {
+      ok = zoom(p, prev);
+      break;
+    }
+    if (alpha >= alpha_max) {  // cannot go further: accept the longest allowed step
+      out = p;
+      ok = true;
+      break;
+    }
+    prev = p;
+    alpha = std::min(2.0 * alpha, alpha_max);
+  }
+  if (ok && last_alpha != out.alpha) {
+    Eigen::VectorXd g;
+    (void)f(u + out.alpha * d, g);  // leave the system at the accepted point
+  }
+  return ok;
+}
+
+}  // namespace mresim::mess::detail

@@ -1,0 +1,36 @@
+#pragma once
+
+// The pieces the inner minimisations share (minimiser.cpp's L-BFGS and FIRE, newton.cpp's
+// Newton-Krylov): the result of one inner minimisation, and the strong-Wolfe line search on
+// the scaled objective (relaxation_common.hpp).
+
+#include <Eigen/Core>
+
+#include "mresim/mess/solvers/minimiser.hpp"
+#include "mresim/mess/solvers/relaxation_common.hpp"
+
+namespace mresim::mess::detail {
+
+struct InnerResult {
+  MinimiserStatus status = MinimiserStatus::max_iterations;
+  int iterations = 0;
+  double energy_change = 0.0;  // scaled
+};
+
+struct LinePoint {
+  double alpha = 0.0;
+  double phi = 0.0;   // scaled potential
+  double dphi = 0.0;  // directional derivative g . d
+  Eigen::VectorXd g;
+};
+
+// Strong-Wolfe line search (Nocedal & Wright Alg. 3.5/3.6) along d from u, with a rounding
+// slack on the sufficient-decrease test and derivative (secant) interpolation in the zoom.
+// On success `out` holds the accepted point and the system is left at it.
+// use_energy = false: forces only (a field that is not exactly a gradient): the energy tests
+// are dropped and the search brackets the zero of the slope g(alpha) . d.
+bool wolfe_line_search(Objective& f, const Eigen::VectorXd& u, const Eigen::VectorXd& d,
+                       LinePoint start, double alpha_init, double alpha_max, bool use_energy,
+                       LinePoint& out);
+
+}  // namespace mresim::mess::detail
