@@ -291,8 +291,9 @@ TEST(MessConfigSystems, Defaults) {
   EXPECT_EQ(s.field.sequence, FieldSequence::loop);
   EXPECT_EQ(s.solver.method, SolverMethod::minimiser);
   EXPECT_EQ(s.solver.minimiser.force_tolerance, 1e-6);
-  EXPECT_EQ(s.solver.magnetization.atol, 1e-3);
-  EXPECT_EQ(s.solver.magnetization.rtol, 5e-3);
+  // M solved tightly by default, for every profile (docs/magnetization-3d.md).
+  EXPECT_EQ(s.solver.magnetization.atol, 1e-12);
+  EXPECT_EQ(s.solver.magnetization.rtol, 1e-12);
   EXPECT_EQ(s.solver.magnetization.max_fixed_point_iterations, 60);
   EXPECT_FALSE(s.solver.magnetization.demagnetization);
   EXPECT_EQ(s.solver.leapfrog.dt, 5e-3);
@@ -312,6 +313,33 @@ TEST(MessConfigSystems, Defaults) {
   EXPECT_EQ(stiff, s.geometry.particle_springs.total());
   ASSERT_EQ(lat.particle_centres.size(), 2u);
   EXPECT_NEAR((lat.particle_centres[1] - s.geometry.particle_centres[1]).norm(), 0.0, 1e-18);
+}
+
+// [solver.magnetization] tolerance: "tight" by default with either profile, "original" the
+// original code's loose band; explicit atol and rtol override the named tolerance.
+TEST(MessConfigSystems, MagnetizationTolerance) {
+  const std::string seed = regular_two(0.05, "profile = \"seed\"");
+  const MessSpec tight = read(seed);
+  EXPECT_EQ(tight.solver.magnetization.atol, 1e-12);
+  EXPECT_EQ(tight.solver.magnetization.rtol, 1e-12);
+  EXPECT_EQ(text(info(tight), "solver", "magnetization_tolerance").rfind("tight", 0), 0u);
+
+  const MessSpec original = read(seed + "[solver.magnetization]\ntolerance = \"original\"\n");
+  EXPECT_EQ(original.solver.magnetization.atol, 1e-3);
+  EXPECT_EQ(original.solver.magnetization.rtol, 5e-3);
+  EXPECT_EQ(number(info(original), "solver", "magnetization_atol"), 1e-3);
+  EXPECT_EQ(text(info(original), "solver", "magnetization_tolerance").rfind("original", 0), 0u);
+
+  const MessSpec mixed =
+      read(regular_two(0.05) + "[solver.magnetization]\ntolerance = \"original\"\natol = 1e-6\n");
+  EXPECT_EQ(mixed.solver.magnetization.atol, 1e-6);
+  EXPECT_EQ(mixed.solver.magnetization.rtol, 5e-3);
+  EXPECT_EQ(text(info(mixed), "solver", "magnetization_tolerance"), "atol and rtol as set");
+
+  const MessSpec named_tight =
+      read(regular_two(0.05) + "[solver.magnetization]\ntolerance = \"tight\"\nrtol = 0\n");
+  EXPECT_EQ(named_tight.solver.magnetization.atol, 1e-12);
+  EXPECT_EQ(named_tight.solver.magnetization.rtol, 0.0);
 }
 
 // The loop of docs/original-code.md#field-sequences: 0 -> max -> -max -> max, 5 n + 1 fields.

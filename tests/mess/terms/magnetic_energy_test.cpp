@@ -288,7 +288,7 @@ TEST(ParticleMagneticEnergy, EnvelopeTheoremWithTheConsistentSelfEnergy) {
 // M's error enters the energy only quadratically, because the energy is stationary in M.
 TEST(ParticleMagneticEnergy, EnvelopeTheoremAtTheDissertationsTolerance) {
   const mm::MagneticModel model = model_at(tesla(0.0, 0.03, 0.04));
-  const Relaxed e = relaxed(kNear, model, mm::MagnetizationOptions{});
+  const Relaxed e = relaxed(kNear, model, mm::MagnetizationOptions::original());
   const Eigen::Matrix3Xd partial = mm::magnetic_gradient(model, kNear, e.history);
   const Eigen::Matrix3Xd total =
       numeric_gradient([&](const Eigen::Matrix3Xd& c) { return e.energy(c); }, kNear, 1e-3 * kR);

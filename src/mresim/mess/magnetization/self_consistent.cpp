@@ -302,6 +302,35 @@ std::string to_string(MagnetizationMethod method) {
   return "unknown";
 }
 
+std::string to_string(MagnetizationTolerance tolerance) {
+  switch (tolerance) {
+    case MagnetizationTolerance::tight:
+      return "tight";
+    case MagnetizationTolerance::original:
+      return "original";
+  }
+  return "unknown";
+}
+
+void MagnetizationOptions::set_tolerance(MagnetizationTolerance tolerance) {
+  switch (tolerance) {
+    case MagnetizationTolerance::tight:
+      atol = kTightAtol;
+      rtol = kTightRtol;
+      return;
+    case MagnetizationTolerance::original:
+      atol = kOriginalAtol;
+      rtol = kOriginalRtol;
+      return;
+  }
+}
+
+MagnetizationOptions MagnetizationOptions::original() {
+  MagnetizationOptions o;
+  o.set_tolerance(MagnetizationTolerance::original);
+  return o;
+}
+
 void MagnetizationOptions::validate() const {
   const auto fail = [](const std::string& what) {
     throw std::invalid_argument("MagnetizationOptions: " + what);

@@ -218,6 +218,18 @@ void describe_field(const MessSpec& s, app::InfoReport& r) {
   r.add(sec, "max_reduced_field", f.max / (kMu0 * s.particles.Ms), "", "h = B/(mu0 Ms)");
 }
 
+// Which named tolerance atol and rtol are (docs/magnetization-3d.md), or that they were set.
+std::string magnetization_tolerance_name(const magnetism::MagnetizationOptions& m) {
+  using O = magnetism::MagnetizationOptions;
+  if (m.atol == O::kTightAtol && m.rtol == O::kTightRtol) {
+    return "tight (M self-consistent to near machine precision)";
+  }
+  if (m.atol == O::kOriginalAtol && m.rtol == O::kOriginalRtol) {
+    return "original (the original code's loose band, M lags the positions within it)";
+  }
+  return "atol and rtol as set";
+}
+
 void describe_solver(const MessSpec& s, app::InfoReport& r) {
   const SolverSpec& v = s.solver;
   const std::string sec = "solver";
@@ -247,6 +259,8 @@ void describe_solver(const MessSpec& s, app::InfoReport& r) {
     r.add(sec, "drag", v.leapfrog.drag, "1/t_c");
   }
   const magnetism::MagnetizationOptions& m = v.magnetization;
+  r.add_text(sec, "magnetization_tolerance", magnetization_tolerance_name(m),
+             "|r_q| <= atol + rtol |m_q| on the fixed-point residual");
   r.add(sec, "magnetization_atol", m.atol, "Ms");
   r.add(sec, "magnetization_rtol", m.rtol, "");
   r.add_text(sec, "magnetization_iterations",
