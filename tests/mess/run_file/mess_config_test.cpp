@@ -322,19 +322,19 @@ TEST(MessConfigSystems, MagnetizationTolerance) {
   const MessSpec tight = read(seed);
   EXPECT_EQ(tight.solver.magnetization.atol, 1e-12);
   EXPECT_EQ(tight.solver.magnetization.rtol, 1e-12);
-  EXPECT_EQ(text(info(tight), "solver", "magnetization_tolerance").rfind("tight", 0), 0u);
+  EXPECT_EQ(text(info(tight), "solver", "magnetization_tolerance"), "tight");
 
   const MessSpec original = read(seed + "[solver.magnetization]\ntolerance = \"original\"\n");
   EXPECT_EQ(original.solver.magnetization.atol, 1e-3);
   EXPECT_EQ(original.solver.magnetization.rtol, 5e-3);
   EXPECT_EQ(number(info(original), "solver", "magnetization_atol"), 1e-3);
-  EXPECT_EQ(text(info(original), "solver", "magnetization_tolerance").rfind("original", 0), 0u);
+  EXPECT_EQ(text(info(original), "solver", "magnetization_tolerance"), "original");
 
   const MessSpec mixed =
       read(regular_two(0.05) + "[solver.magnetization]\ntolerance = \"original\"\natol = 1e-6\n");
   EXPECT_EQ(mixed.solver.magnetization.atol, 1e-6);
   EXPECT_EQ(mixed.solver.magnetization.rtol, 5e-3);
-  EXPECT_EQ(text(info(mixed), "solver", "magnetization_tolerance"), "atol and rtol as set");
+  EXPECT_EQ(text(info(mixed), "solver", "magnetization_tolerance"), "custom");
 
   const MessSpec named_tight =
       read(regular_two(0.05) + "[solver.magnetization]\ntolerance = \"tight\"\nrtol = 0\n");

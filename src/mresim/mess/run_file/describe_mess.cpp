@@ -222,12 +222,12 @@ void describe_field(const MessSpec& s, app::InfoReport& r) {
 std::string magnetization_tolerance_name(const magnetism::MagnetizationOptions& m) {
   using O = magnetism::MagnetizationOptions;
   if (m.atol == O::kTightAtol && m.rtol == O::kTightRtol) {
-    return "tight (M self-consistent to near machine precision)";
+    return "tight";
   }
   if (m.atol == O::kOriginalAtol && m.rtol == O::kOriginalRtol) {
-    return "original (the original code's loose band, M lags the positions within it)";
+    return "original";
   }
-  return "atol and rtol as set";
+  return "custom";
 }
 
 void describe_solver(const MessSpec& s, app::InfoReport& r) {
@@ -259,8 +259,11 @@ void describe_solver(const MessSpec& s, app::InfoReport& r) {
     r.add(sec, "drag", v.leapfrog.drag, "1/t_c");
   }
   const magnetism::MagnetizationOptions& m = v.magnetization;
-  r.add_text(sec, "magnetization_tolerance", magnetization_tolerance_name(m),
-             "|r_q| <= atol + rtol |m_q| on the fixed-point residual");
+  const std::string tolerance = magnetization_tolerance_name(m);
+  r.add_text(sec, "magnetization_tolerance", tolerance,
+             tolerance == "tight"      ? "M self-consistent to near machine precision"
+             : tolerance == "original" ? "the original code's loose band: M lags the positions"
+                                       : "atol and rtol as set");
   r.add(sec, "magnetization_atol", m.atol, "Ms");
   r.add(sec, "magnetization_rtol", m.rtol, "");
   r.add_text(sec, "magnetization_iterations",
