@@ -147,5 +147,26 @@ TEST(MessProtocolKinds, LeapfrogRunMatchesTheMinimiser) {
   EXPECT_EQ(b.status, "converged");
 }
 
+// solver.method = "newton" follows the same states along a loop as the default L-BFGS, with
+// one multigrid for all steps: centres to 1 nm, energies to 1e-6 relative.
+TEST(MessProtocolKinds, NewtonRunFollowsTheLbfgsLoop) {
+  const std::string base = testing::small_hysteresis(0.05, 2);
+  const ProtocolRun lbfgs = run(base);
+  const ProtocolRun newton = run(base + "\n[solver]\nmethod = \"newton\"\n");
+  ASSERT_EQ(newton.state.records.size(), lbfgs.state.records.size());
+  ASSERT_EQ(newton.state.records.size(), 11U);  // 0 -> max -> -max -> max
+  for (std::size_t k = 0; k < lbfgs.state.records.size(); ++k) {
+    const StepRecord& a = lbfgs.state.records[k];
+    const StepRecord& b = newton.state.records[k];
+    EXPECT_EQ(b.status, "converged") << k;
+    EXPECT_LT((a.centres - b.centres).cwiseAbs().maxCoeff(), 1e-9) << k;
+    EXPECT_NEAR(b.energies.total(), a.energies.total(), 1e-6 * std::abs(a.energies.total()) + 1e-22)
+        << k;
+    if (k > 0) {
+      EXPECT_LT(b.iterations, a.iterations) << k;  // Newton steps against L-BFGS steps
+    }
+  }
+}
+
 }  // namespace
 }  // namespace mresim::mess_protocol

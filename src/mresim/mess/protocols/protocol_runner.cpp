@@ -96,8 +96,12 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   StepRecord record;
   record.step = step;
   const double b = step.field.norm();
-  if (spec_.solver.method == mc::SolverMethod::minimiser) {
+  if (spec_.solver.method != mc::SolverMethod::leapfrog) {
     mess::MinimiserOptions options;
+    if (spec_.solver.method == mc::SolverMethod::newton) {
+      options.method = mess::MinimiserMethod::newton;
+      options.newton_cache = newton_cache_;  // one multigrid for the run's steps
+    }
     options.force_tolerance = spec_.solver.minimiser.force_tolerance;
     options.max_iterations = static_cast<int>(spec_.solver.minimiser.max_iterations);
     const mess::MinimiserResult r = mess::minimise(system_, options);

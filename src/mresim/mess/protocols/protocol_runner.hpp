@@ -20,11 +20,13 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "mresim/mess/protocols/step_plan.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
+#include "mresim/mess/solvers/newton.hpp"
 #include "mresim/mess/system/system_energy.hpp"
 
 namespace mresim::mess_protocol {
@@ -91,6 +93,8 @@ class ProtocolRunner {
   mess_config::MessSpec spec_;
   std::vector<StepSpec> steps_;
   mess::MessSystem system_;
+  // solver.method = "newton": the multigrid, built at the first step and kept for the others.
+  std::shared_ptr<mess::NewtonCache> newton_cache_ = std::make_shared<mess::NewtonCache>();
 };
 
 // Sum of the cell volumes (m^3) at positions x.

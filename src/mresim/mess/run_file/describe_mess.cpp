@@ -233,8 +233,10 @@ std::string magnetization_tolerance_name(const magnetism::MagnetizationOptions& 
 void describe_solver(const MessSpec& s, app::InfoReport& r) {
   const SolverSpec& v = s.solver;
   const std::string sec = "solver";
-  if (v.method == SolverMethod::minimiser) {
-    r.add_text(sec, "method", "minimiser");
+  if (v.method != SolverMethod::leapfrog) {
+    r.add_text(sec, "method", v.method == SolverMethod::newton ? "newton" : "lbfgs",
+               v.method == SolverMethod::newton ? "Newton-Krylov with algebraic multigrid"
+                                                : "preconditioned L-BFGS");
     r.add(sec, "force_tolerance", v.minimiser.force_tolerance, "k_eff l_e",
           "largest net force on a free node");
     r.add_integer(sec, "max_iterations", v.minimiser.max_iterations);

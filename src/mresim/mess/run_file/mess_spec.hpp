@@ -122,7 +122,10 @@ struct StressSpec {
 // ---------------------------------------------------------------------------------------------
 // [solver] and [output]
 
-enum class SolverMethod { minimiser, leapfrog };
+// [solver] method: "lbfgs" (also spelt "minimiser", the default), "newton" (Newton-Krylov with
+// algebraic multigrid, for large lattices: docs/mess-solvers.md) or "leapfrog" (the seed's
+// damped dynamics).
+enum class SolverMethod { lbfgs, newton, leapfrog };
 
 struct MinimiserSettings {
   // Converged when the largest net force on a free node is below force_tolerance * k_eff l_e
@@ -147,7 +150,7 @@ struct LeapfrogSettings {
 std::optional<double> leapfrog_stability_limit(int discretization_order);
 
 struct SolverSpec {
-  SolverMethod method = SolverMethod::minimiser;
+  SolverMethod method = SolverMethod::lbfgs;
   MinimiserSettings minimiser;
   LeapfrogSettings leapfrog;
   // atol, rtol, iteration budgets; `demagnetization` mirrors MessSpec::demagnetization.

@@ -519,9 +519,13 @@ void read_solver(const std::optional<TableReader>& solver, bool demagnetization,
   s.magnetization.demagnetization = demagnetization;
   if (!solver) return;
   const TableReader& t = *solver;
-  const std::string method = t.choice_or("method", "minimiser", {"minimiser", "leapfrog"});
-  s.method = method == "minimiser" ? SolverMethod::minimiser : SolverMethod::leapfrog;
-  const std::string other = method == "minimiser" ? "leapfrog" : "minimiser";
+  const std::string method =
+      t.choice_or("method", "minimiser", {"minimiser", "lbfgs", "newton", "leapfrog"});
+  s.method = method == "leapfrog" ? SolverMethod::leapfrog
+             : method == "newton" ? SolverMethod::newton
+                                  : SolverMethod::lbfgs;
+  // [solver.minimiser] holds the criteria of lbfgs and newton alike.
+  const std::string other = method == "leapfrog" ? "minimiser" : "leapfrog";
   if (t.has(other)) {
     t.fail(
         other, t.value_text(other),

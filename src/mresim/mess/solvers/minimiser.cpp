@@ -384,8 +384,12 @@ class Minimisation {
     res_.max_force = measure_.max_force(f_.full_gradient());
     res_.evaluations = f_.evaluations();
     if (newton_ != nullptr) {
+      newton_->finish();
       res_.krylov_iterations = newton_->krylov_iterations();
       res_.preconditioner_seconds = newton_->preconditioner_seconds();
+      res_.multigrid_seconds = newton_->timings().multigrid;
+      res_.hessian_product_seconds = newton_->timings().products;
+      res_.centre_hessian_seconds = newton_->timings().centre_hessian;
     }
     res_.converged = res_.status == MinimiserStatus::converged;
     return res_;
@@ -414,10 +418,12 @@ class Minimisation {
     const auto test = [this](const Eigen::VectorXd& /*g*/, double energy_change) {
       return converged(energy_change);
     };
-    // Newton needs an exact gradient: the seed's forces-only phase goes to L-BFGS.
-    if (method_ == MinimiserMethod::newton && use_energy_) {
+    // Newton; in the seed's forces-only phase with the conservative neighbour's Hessian as the
+    // Jacobian of the seed's forces (they differ by the particles' internal deformation).
+    if (method_ == MinimiserMethod::newton) {
       if (newton_ == nullptr) {
-        newton_ = std::make_unique<detail::NewtonSolver>(system_, map_, force_scale_, opt_.newton);
+        newton_ = std::make_unique<detail::NewtonSolver>(system_, map_, force_scale_, opt_.newton,
+                                                         opt_.newton_cache);
       }
       return newton_->run(f_, u_, budget_, opt_, use_energy_, test);
     }
@@ -453,7 +459,7 @@ class Minimisation {
     }
     if (failed) {
       if (method_ == MinimiserMethod::fire) return false;
-      if (method_ == MinimiserMethod::newton && use_energy_) {
+      if (method_ == MinimiserMethod::newton) {
         // Newton's line search failed twice in a row: L-BFGS continues from here.
         method_ = MinimiserMethod::lbfgs;
         res_.finished_with_lbfgs = true;

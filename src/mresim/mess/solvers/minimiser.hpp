@@ -53,6 +53,7 @@
 // floor keeps tiny energies, dominated by their own rounding, from blocking convergence).
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include "mresim/mess/solvers/amg_preconditioner.hpp"
@@ -91,6 +92,8 @@ struct NewtonOptions {
   AmgOptions amg;
 };
 
+struct NewtonCache;  // newton.hpp
+
 struct MinimiserOptions {
   MinimiserMethod method = MinimiserMethod::lbfgs;
   double force_tolerance = 1e-6;    // relative to force_scale
@@ -107,6 +110,9 @@ struct MinimiserOptions {
   double max_step = 0.2;  // largest coordinate change per iteration, in units of l_e
   FireParameters fire;
   NewtonOptions newton;
+  // newton: where the multigrid is kept between calls (a caller relaxing many steps of one
+  // run keeps one; null: built anew in every call).
+  std::shared_ptr<NewtonCache> newton_cache;
 
   void validate() const;  // throws std::invalid_argument naming the option
 };
@@ -122,7 +128,10 @@ struct MinimiserResult {
   bool finished_with_lbfgs = false;       // newton's line search failed; L-BFGS went on
   std::int64_t evaluations = 0;           // energy + gradient evaluations
   std::int64_t krylov_iterations = 0;     // newton: CG iterations (Hessian products)
-  double preconditioner_seconds = 0.0;    // newton: building the multigrid
+  double preconditioner_seconds = 0.0;    // newton: building the multigrid (0 when reused)
+  double multigrid_seconds = 0.0;         // newton: applying it (V-cycles)
+  double hessian_product_seconds = 0.0;   // newton: Hessian-vector products
+  double centre_hessian_seconds = 0.0;    // newton: reduced centre Hessians
   double max_force = 0.0;                 // N, the convergence measure at the end
   double force_scale = 0.0;               // N
   double energy_change = 0.0;             // J, potential change over the last iteration

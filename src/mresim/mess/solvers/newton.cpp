@@ -8,37 +8,89 @@
 
 namespace mresim::mess::detail {
 
-NewtonSolver::NewtonSolver(MessSystem& system, const DofMap& map, double force_scale,
-                           const NewtonOptions& options)
-    : system_(system), map_(map), force_scale_(force_scale), options_(options) {
-  if (system.settings().centre_rule != CentreRule::all_nodes) {
-    throw std::logic_error("NewtonSolver: needs CentreRule::all_nodes (an exact gradient)");
+namespace {
+
+// Adds the wall time of its lifetime to `total`.
+class Stopwatch {
+ public:
+  explicit Stopwatch(double& total) : total_(total), start_(std::chrono::steady_clock::now()) {}
+  Stopwatch(const Stopwatch&) = delete;
+  Stopwatch& operator=(const Stopwatch&) = delete;
+  Stopwatch(Stopwatch&&) = delete;
+  Stopwatch& operator=(Stopwatch&&) = delete;
+  ~Stopwatch() {
+    total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   }
-  build_preconditioner();
+
+ private:
+  double& total_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace
+
+NewtonSolver::NewtonSolver(MessSystem& system, const DofMap& map, double force_scale,
+                           const NewtonOptions& options, std::shared_ptr<NewtonCache> cache)
+    : system_(system),
+      map_(map),
+      force_scale_(force_scale),
+      options_(options),
+      centre_hessian_(
+          Eigen::MatrixXd::Zero(3 * static_cast<Eigen::Index>(system.particle_count()),
+                                3 * static_cast<Eigen::Index>(system.particle_count()))),
+      cache_(cache != nullptr ? std::move(cache) : std::make_shared<NewtonCache>()) {
+  const std::vector<std::uint8_t> own = map_.own_dof_mask();
+  NewtonPreconditioner* kept = cache_->current.get();
+  if (kept != nullptr && !kept->stale && kept->own_dofs == own &&
+      kept->group_diagonal.size() == 3 * map_.groups()) {
+    pc_ = kept;
+  } else {
+    build_preconditioner();
+  }
 }
 
 void NewtonSolver::build_preconditioner() {
   const auto start = std::chrono::steady_clock::now();
   const double l_e = map_.length_scale();
-  matrix_ = std::make_unique<ElasticMatrix>(system_.lattice());
+  auto pc = std::make_unique<NewtonPreconditioner>();
+  pc->own_dofs = map_.own_dof_mask();
+  pc->matrix = std::make_unique<ElasticMatrix>(system_.lattice());
   // Scaled like the free variables: H_u = l_e H_x / F0.
-  matrix_->assemble(system_, map_.own_dof_mask(), l_e / force_scale_);
+  pc->matrix->assemble(system_, pc->own_dofs, l_e / force_scale_);
   const Eigen::Matrix3Xd coordinates = system_.positions() / l_e;
-  amg_ = std::make_unique<AmgPreconditioner>(*matrix_, coordinates, options_.amg);
+  pc->amg = std::make_unique<AmgPreconditioner>(*pc->matrix, coordinates, options_.amg);
+  cache_->current = std::move(pc);
+  ++cache_->setups;
+  pc_ = cache_->current.get();
   // The rigid groups' translations: their diagonal of H (M's dependence left out).
   const Eigen::Index own = map_.own_dofs();
-  group_diagonal_.resize(3 * map_.groups());
-  centre_hessian_ = Eigen::MatrixXd::Zero(3 * static_cast<Eigen::Index>(system_.particle_count()),
-                                          3 * static_cast<Eigen::Index>(system_.particle_count()));
-  for (Eigen::Index k = 0; k < group_diagonal_.size(); ++k) {
+  pc_->group_diagonal = Eigen::VectorXd::Ones(3 * map_.groups());
+  for (Eigen::Index k = 0; k < pc_->group_diagonal.size(); ++k) {
     Eigen::VectorXd unit = Eigen::VectorXd::Zero(map_.size());
     unit[own + k] = 1.0;
-    group_diagonal_[k] = std::max(hessian_product(unit)[own + k], 1e-300);
+    pc_->group_diagonal[k] = std::max(hessian_product(unit)[own + k], 1e-300);
   }
   setup_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+void NewtonSolver::finish() {
+  if (newton_steps_ == 0) return;
+  const double per_step =
+      static_cast<double>(krylov_iterations_) / static_cast<double>(newton_steps_);
+  if (pc_->baseline_krylov_per_step < 0.0) {
+    pc_->baseline_krylov_per_step = per_step;
+  } else if (per_step > 2.0 * pc_->baseline_krylov_per_step + 10.0) {
+    pc_->stale = true;
+  }
+}
+
+void NewtonSolver::update_centre_hessian() {
+  const Stopwatch watch(timings_.centre_hessian);
+  centre_hessian_ = system_.reduced_centre_hessian();
+}
+
 Eigen::VectorXd NewtonSolver::hessian_product(const Eigen::VectorXd& v) const {
+  const Stopwatch watch(timings_.products);
   const Eigen::Matrix3Xd w = map_.expand(v);
   Eigen::Matrix3Xd y = system_.elastic_hessian_product(w);
   const auto& particles = system_.lattice().particle_nodes;
@@ -65,13 +117,17 @@ Eigen::VectorXd NewtonSolver::hessian_product(const Eigen::VectorXd& v) const {
 
 Eigen::VectorXd NewtonSolver::precondition(const Eigen::VectorXd& r) const {
   const Eigen::Index own = map_.own_dofs();
-  Eigen::VectorXd nodes = Eigen::VectorXd::Zero(matrix_->rows());
+  Eigen::VectorXd nodes = Eigen::VectorXd::Zero(pc_->matrix->rows());
   for (Eigen::Index k = 0; k < own; ++k) nodes[map_.coordinate_of(k)] = r[k];
   Eigen::VectorXd z_nodes;
-  amg_->apply(nodes, z_nodes);
+  {
+    const Stopwatch watch(timings_.multigrid);
+    pc_->amg->apply(nodes, z_nodes);
+  }
   Eigen::VectorXd z(r.size());
   for (Eigen::Index k = 0; k < own; ++k) z[k] = z_nodes[map_.coordinate_of(k)];
-  z.tail(group_diagonal_.size()) = r.tail(group_diagonal_.size()).cwiseQuotient(group_diagonal_);
+  const Eigen::Index groups = pc_->group_diagonal.size();
+  z.tail(groups) = r.tail(groups).cwiseQuotient(pc_->group_diagonal);
   return z;
 }
 
@@ -136,6 +192,7 @@ InnerResult NewtonSolver::run(Objective& f, Eigen::VectorXd& u, int budget,
     LinePoint next;
     const bool ok = wolfe_line_search(f, u, d, cur, 1.0, alpha_max, use_energy, next);
     ++r.iterations;
+    ++newton_steps_;
     if (!ok) {
       if (++failures >= 2) {
         r.status = MinimiserStatus::line_search_failed;

@@ -23,13 +23,17 @@
 // and kept for all its Newton steps; the magnetic low-rank term is left to CG (3 N_p extra
 // directions at most).
 //
-// Requires exact gradients: CentreRule::all_nodes (minimise() runs the seed's conservative
-// neighbour first, and L-BFGS for its forces-only phase).
+// The Hessian is always the conservative one (centres = mean of all particle nodes). With the
+// seed's CentreRule::centre_voxel, whose forces are not exactly a gradient, minimise() runs
+// the conservative neighbour first and then Newton iterations on the seed's own forces with
+// that Hessian as their Jacobian (the two differ by the particles' internal deformation) and
+// the slope-only line search.
 
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <vector>
 
 #include "mresim/mess/solvers/amg_preconditioner.hpp"
 #include "mresim/mess/solvers/hessian_assembly.hpp"
@@ -40,24 +44,66 @@ namespace mresim::mess::detail {
 
 using ConvergenceTest = std::function<bool(const Eigen::VectorXd&, double)>;
 
+// Wall time of the parts of the solver (s).
+struct NewtonTimings {
+  double multigrid = 0.0;
+  double products = 0.0;
+  double centre_hessian = 0.0;
+};
+
+}  // namespace mresim::mess::detail
+
+namespace mresim::mess {
+
+// The multigrid of one set of constraints, with what it was built for.
+struct NewtonPreconditioner {
+  std::vector<std::uint8_t> own_dofs;  // DofMap::own_dof_mask() it was built for
+  std::unique_ptr<ElasticMatrix> matrix;
+  std::unique_ptr<AmgPreconditioner> amg;
+  Eigen::VectorXd group_diagonal;  // H's diagonal on the rigid groups' translations
+  // CG iterations per Newton step in the first minimise() call that used it; a later call
+  // needing more than twice that (plus 10) marks it stale, and the next call rebuilds it at
+  // its own starting positions.
+  double baseline_krylov_per_step = -1.0;
+  bool stale = false;
+};
+
+// Kept by a caller between minimise() calls (MinimiserOptions::newton_cache) so that the
+// multigrid, whose setup costs about as much as 20-40 CG iterations, is built once per run
+// rather than once per field or strain step: the elastic Hessian changes little between steps,
+// and a preconditioner need only be close. Rebuilt when the constraints change or it is stale.
+struct NewtonCache {
+  std::unique_ptr<NewtonPreconditioner> current;
+  int setups = 0;
+};
+
+}  // namespace mresim::mess
+
+namespace mresim::mess::detail {
+
 class NewtonSolver {
  public:
+  // `cache`: where the multigrid is kept (null: built for this solver alone).
   NewtonSolver(MessSystem& system, const DofMap& map, double force_scale,
-               const NewtonOptions& options);
+               const NewtonOptions& options, std::shared_ptr<NewtonCache> cache = nullptr);
 
   // Newton steps from u until `converged`, the budget (Newton steps) or a failure.
   InnerResult run(Objective& f, Eigen::VectorXd& u, int budget, const MinimiserOptions& options,
                   bool use_energy, const ConvergenceTest& converged);
+  // At the end of a minimise() call: judges whether the kept multigrid has gone stale.
+  void finish();
 
   std::int64_t krylov_iterations() const { return krylov_iterations_; }
+  int newton_steps() const { return newton_steps_; }
   double preconditioner_seconds() const { return setup_seconds_; }
+  const NewtonTimings& timings() const { return timings_; }
 
   // H v in the scaled free variables (see the header), at the system's current state; the
   // centre Hessian is the one of the last update_centre_hessian().
   Eigen::VectorXd hessian_product(const Eigen::VectorXd& v) const;
   // The preconditioner: approximately H^-1 r.
   Eigen::VectorXd precondition(const Eigen::VectorXd& r) const;
-  void update_centre_hessian() { centre_hessian_ = system_.reduced_centre_hessian(); }
+  void update_centre_hessian();
 
  private:
   void build_preconditioner();
@@ -70,11 +116,12 @@ class NewtonSolver {
   double force_scale_;
   NewtonOptions options_;
   Eigen::MatrixXd centre_hessian_;
-  std::unique_ptr<ElasticMatrix> matrix_;
-  std::unique_ptr<AmgPreconditioner> amg_;
-  Eigen::VectorXd group_diagonal_;  // H's diagonal on the rigid groups' translations
+  std::shared_ptr<NewtonCache> cache_;
+  NewtonPreconditioner* pc_ = nullptr;  // cache_->current
   std::int64_t krylov_iterations_ = 0;
+  int newton_steps_ = 0;
   double setup_seconds_ = 0.0;
+  mutable NewtonTimings timings_;
 };
 
 }  // namespace mresim::mess::detail

@@ -1,0 +1,201 @@
+// How the cost of one 3D relaxation grows with the lattice: the same physical system (two
+// particles, R = 1.5 um, 6.5454 um apart along z in an 8 x 8 x 14.7 um box, particle volume
+// fraction 3 %, all faces held) discretised at n_d = 1 ... 5 (1.3k to 41k nodes), relaxed after the
+// field steps from 0 to 40 mT along z, with each method's default convergence criteria
+// (max force 1e-6 k_eff l_e). Prints per size and method: nodes, wall and CPU time, outer
+// iterations (Newton or L-BFGS steps), inner iterations (CG), evaluations, and the agreement
+// of the final states; then the exponent p of time ~ N^p fitted over n_d = 2 ... 5 and the
+// time ratios lbfgs / newton measured in this run. docs/performance.md records the results.
+//
+//   ./build/mess_scaling_bench                      (seed profile, n_d = 1..5, both methods)
+//   ./build/mess_scaling_bench --orders 1,2,3 --profile physical --lbfgs-max-order 3
+#include <sys/resource.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "mresim/core/constants.hpp"
+#include "mresim/mess/lattice/lattice.hpp"
+#include "mresim/mess/profile/model_profile.hpp"
+#include "mresim/mess/solvers/minimiser.hpp"
+
+namespace {
+
+namespace mess = mresim::mess;
+namespace lat = mresim::lattice;
+
+constexpr double kRadius = 1.5e-6;
+constexpr double kSeparation = 6.5454e-6;
+// 8 x 8 x 14.7 um: 2 x 4/3 pi R^3 / V = 3 %; long in z so that n_d = 1 still fits the pair.
+constexpr double kSide = 8e-6;
+constexpr double kHeight = 14.7e-6;
+constexpr double kField = 0.04;  // T
+
+mess::MessSystem make_system(const mess::ModelProfile& profile, int order) {
+  lat::LatticeSpec spec;
+  profile.apply_to(spec);
+  spec.discretization_order = order;
+  const double l_e = lat::element_length(kRadius, order);
+  // Odd cell counts, so that the centre cell is the box's middle; centre cells nearest to the
+  // physical positions, mirror-symmetric in z.
+  const auto odd_cells = [&](double length) {
+    return 2 * static_cast<int>(std::lround(0.5 * (length / l_e - 1.0))) + 1;
+  };
+  const int side = odd_cells(kSide);
+  const int height = odd_cells(kHeight);
+  const int half_gap = static_cast<int>(std::lround(0.5 * kSeparation / l_e));
+  lat::ByHandPlacement placement;
+  placement.box.lengths = Eigen::Vector3d(side, side, height) * l_e;
+  for (const int k : {height / 2 - half_gap, height / 2 + half_gap}) {
+    placement.positions.emplace_back((side / 2 + 0.5) * l_e, (side / 2 + 0.5) * l_e,
+                                     (k + 0.5) * l_e);
+  }
+  spec.placement = placement;
+  mess::MessSystem sys = mess::MessSystem::make(
+      lat::build_lattice(spec), Eigen::Vector3d(0.0, 0.0, kField) / mresim::kMu0, profile);
+  const lat::Lattice& l = sys.lattice();
+  mess::BoundaryConstraints c = mess::BoundaryConstraints::none(l.node_count());
+  for (const lat::Face f : {lat::Face::left, lat::Face::right, lat::Face::front, lat::Face::back,
+                            lat::Face::bottom, lat::Face::top}) {
+    c.fix_face(l.shape, f, l.positions);
+  }
+  sys.set_constraints(c);
+  return sys;
+}
+
+double cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+struct Outcome {
+  mess::MinimiserResult result;
+  double wall = 0.0;
+  double cpu = 0.0;
+  Eigen::Matrix3Xd centres;  // l_e
+  Eigen::Matrix3Xd magnetizations;
+};
+
+Outcome relax(const mess::ModelProfile& profile, int order, mess::MinimiserMethod method) {
+  mess::MessSystem sys = make_system(profile, order);
+  mess::MinimiserOptions options;
+  options.method = method;
+  Outcome o;
+  const auto start = std::chrono::steady_clock::now();
+  const double cpu0 = cpu_seconds();
+  o.result = mess::minimise(sys, options);
+  o.cpu = cpu_seconds() - cpu0;
+  o.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  o.centres = sys.particle_centres() / sys.length_scale();
+  o.magnetizations = sys.magnetizations() / sys.model().particles.Ms;
+  return o;
+}
+
+void print(int order, std::int64_t nodes, const char* method, const Outcome& o) {
+  const mess::MinimiserResult& r = o.result;
+  std::printf(
+      "n_d=%d %8lld nodes  %-6s  wall %8.2f s  cpu %8.2f s  outer %6d  inner %7lld  "
+      "evaluations %7lld  setup %6.2f s  %s%s\n",
+      order, static_cast<long long>(nodes), method, o.wall, o.cpu, r.iterations,
+      static_cast<long long>(r.krylov_iterations), static_cast<long long>(r.evaluations),
+      r.preconditioner_seconds, mess::to_string(r.status).c_str(),
+      r.finished_with_lbfgs ? " (finished with lbfgs)" : "");
+  if (r.krylov_iterations > 0) {
+    std::printf(
+        "        newton parts: multigrid %.2f s, Hessian products %.2f s, centre Hessians "
+        "%.2f s, setup %.2f s\n",
+        r.multigrid_seconds, r.hessian_product_seconds, r.centre_hessian_seconds,
+        r.preconditioner_seconds);
+  }
+  std::fflush(stdout);
+}
+
+// Least-squares slope of log t against log N.
+double exponent(const std::vector<double>& nodes, const std::vector<double>& seconds) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  const auto n = static_cast<double>(nodes.size());
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    const double x = std::log(nodes[k]);
+    const double y = std::log(seconds[k]);
+    sx += x;
+    sy += y;
+    sxx += x * x;
+    sxy += x * y;
+  }
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+std::vector<int> parse_orders(const std::string& text) {
+  std::vector<int> orders;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) orders.push_back(std::stoi(item));
+  return orders;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string profile_name = "seed";
+  std::vector<int> orders = {1, 2, 3, 4, 5};
+  int lbfgs_max_order = 5;
+  for (int k = 1; k + 1 < argc; k += 2) {
+    const std::string key = argv[k];
+    if (key == "--profile") {
+      profile_name = argv[k + 1];
+    } else if (key == "--orders") {
+      orders = parse_orders(argv[k + 1]);
+    } else if (key == "--lbfgs-max-order") {
+      lbfgs_max_order = std::stoi(argv[k + 1]);
+    } else {
+      std::fprintf(stderr, "unknown option %s (--profile, --orders, --lbfgs-max-order)\n", argv[k]);
+      return 2;
+    }
+  }
+  const mess::ModelProfile& profile = mess::model_profile(profile_name);
+  double load[3] = {0, 0, 0};
+  if (getloadavg(load, 3) > 0) std::printf("load average at start: %.2f\n", load[0]);
+  std::printf("profile %s, 0 -> %.0f mT, OpenMP threads as set by OMP_NUM_THREADS\n",
+              profile_name.c_str(), 1e3 * kField);
+  std::vector<double> nodes_fit;
+  std::vector<double> newton_fit;
+  std::vector<double> lbfgs_fit;
+  for (const int order : orders) {
+    const std::int64_t nodes = make_system(profile, order).node_count();
+    const Outcome n = relax(profile, order, mess::MinimiserMethod::newton);
+    print(order, nodes, "newton", n);
+    if (order <= lbfgs_max_order) {
+      const Outcome l = relax(profile, order, mess::MinimiserMethod::lbfgs);
+      print(order, nodes, "lbfgs", l);
+      std::printf(
+          "        lbfgs/newton wall %.2fx, cpu %.2fx; max |centre difference| %.2e l_e, "
+          "max |M/Ms difference| %.2e\n",
+          l.wall / n.wall, l.cpu / n.cpu, (l.centres - n.centres).cwiseAbs().maxCoeff(),
+          (l.magnetizations - n.magnetizations).cwiseAbs().maxCoeff());
+      if (order >= 2) lbfgs_fit.push_back(l.wall);
+    }
+    if (order >= 2) {
+      nodes_fit.push_back(static_cast<double>(nodes));
+      newton_fit.push_back(n.wall);
+    }
+  }
+  if (nodes_fit.size() >= 2) {
+    std::printf("time ~ N^p over n_d >= 2: newton p = %.2f", exponent(nodes_fit, newton_fit));
+    if (lbfgs_fit.size() == nodes_fit.size()) {
+      std::printf(", lbfgs p = %.2f", exponent(nodes_fit, lbfgs_fit));
+    }
+    std::printf("\n");
+  }
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  std::printf("peak resident memory of the process: %.1f MiB\n",
+              static_cast<double>(usage.ru_maxrss) / 1024.0);
+  return 0;
+}
