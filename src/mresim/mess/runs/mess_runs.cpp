@@ -20,6 +20,7 @@
 #include "mresim/mess/outputs/mess_outputs.hpp"
 #include "mresim/mess/protocols/protocol_runner.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
+#include "mresim/mess/solvers/amg_preconditioner.hpp"
 #include "mresim/pair/runs/pair_outputs.hpp"
 
 namespace mresim::mess_protocol {
@@ -36,6 +37,9 @@ class MessPlan final : public app::RunPlan {
         input_name_(root.source_name()) {
     // Refuse what cannot fit before the lattice is allocated or anything is written.
     mc::check_memory(spec_, mc::available_memory());
+    // MPI's start forks a helper that would keep results.h5 locked: start it before any file
+    // is opened (amg_preconditioner.hpp).
+    if (spec_.solver.method == mc::SolverMethod::newton) mess::initialise_petsc();
   }
 
   void describe(app::InfoReport& report) const override { mc::describe_mess(spec_, report); }

@@ -18,10 +18,11 @@ void check(PetscErrorCode code, const char* what) {
                            (text != nullptr ? text : "error " + std::to_string(code)));
 }
 
-// Initialises PETSc (and MPI, as a singleton when the program was not started by mpirun) the
-// first time a preconditioner is built; finalised at exit. PETSc's errors are returned, not
-// printed, so that check() can report them.
-void ensure_petsc() {
+}  // namespace
+
+// PETSc (and MPI, as a singleton when the program was not started by mpirun) is finalised at
+// exit. PETSc's errors are returned, not printed, so that check() can report them.
+void initialise_petsc() {
   static const bool initialised = [] {
     PetscBool already = PETSC_FALSE;
     check(PetscInitialized(&already), "PetscInitialized");
@@ -34,8 +35,6 @@ void ensure_petsc() {
   }();
   (void)initialised;
 }
-
-}  // namespace
 
 struct AmgPreconditioner::Impl {
   Mat matrix = nullptr;
@@ -61,7 +60,7 @@ AmgPreconditioner::AmgPreconditioner(const ElasticMatrix& matrix,
                                      const Eigen::Matrix3Xd& coordinates, const AmgOptions& options)
     : impl_(std::make_unique<Impl>()) {
   static_assert(sizeof(PetscInt) == sizeof(std::int32_t), "PETSc with 32-bit indices expected");
-  ensure_petsc();
+  initialise_petsc();
   Impl& p = *impl_;
   p.size = matrix.rows();
   if (coordinates.size() != p.size) {

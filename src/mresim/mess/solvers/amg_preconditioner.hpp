@@ -23,6 +23,13 @@
 
 namespace mresim::mess {
 
+// Initialises PETSc and MPI now (idempotent; the preconditioner calls it too). A program that
+// will use the multigrid calls it before it opens files that another process must open while
+// it runs: MPI's singleton start (no mpirun) forks a helper process, which inherits the open
+// file descriptors and with them HDF5's file locks (the plot script then could not read
+// results.h5).
+void initialise_petsc();
+
 struct AmgOptions {
   double threshold = 0.02;  // GAMG's strength-of-connection threshold
   int smoothings = 1;       // prolongator smoothing steps (smoothed aggregation)
