@@ -276,6 +276,34 @@ TEST(Cli, RunDrawsFiguresWithThePlotScript) {
   EXPECT_EQ(mresim(dir.path(), "plot demo", env).status, 7);
 }
 
+// A 3D run with solver.method = "newton" starts MPI, whose singleton start forks a helper
+// process; started after results.h5 was open, the helper kept HDF5's lock on it and the plot
+// script could not read it. The fake script takes the shared lock h5py would.
+TEST(Cli, NewtonRunLeavesTheResultsReadableToThePlotScript) {
+  if (!have_python3()) GTEST_SKIP() << "python3 not found";
+  const TempDir dir;
+  fs::create_directories(dir / "py");
+  write_text(dir / "py" / "mresim_plot.py",
+             "import fcntl, os, sys\n"
+             "fd = os.open(os.path.join(sys.argv[1], 'results.h5'), os.O_RDONLY)\n"
+             "try:\n"
+             "    fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)\n"
+             "except OSError:\n"
+             "    sys.exit(9)\n"
+             "sys.exit(0)\n");
+  write_text(dir / "newton.toml",
+             "[run]\ntype = \"mess_hysteresis\"\n"
+             "[model]\nprofile = \"physical\"\ndiscretization_order = 1\n"
+             "[particles]\nplacement = \"chain\"\ncount = 2\nseparation = 7e-6\naxis = \"z\"\n"
+             "[box]\nsize = [9e-6, 9e-6, 17e-6]\n"
+             "[field]\nmagnitudes = [0.02]\nsequence = \"up\"\n"
+             "[solver]\nmethod = \"newton\"\n");
+  const Result r =
+      mresim(dir.path(), "run newton.toml", "MRESIM_PYTHON_DIR='" + (dir / "py").string() + "'");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(dir / "newton" / "results.h5"));
+}
+
 TEST(Cli, AFailedPlotAfterASuccessfulRunExitsWith3) {
   if (!have_python3()) GTEST_SKIP() << "python3 not found";
   const TempDir dir;
