@@ -179,10 +179,14 @@ InnerResult NewtonSolver::run(Objective& f, Eigen::VectorXd& u, int budget,
   while (r.iterations < budget) {
     update_centre_hessian();
     const double gmax = cur.g.cwiseAbs().maxCoeff();
+    // CG's relative residual: sqrt(|g|) for superlinear convergence, but no tighter than what
+    // takes the forces to half the tolerance (the scaled gradient is in units of the force
+    // scale, so the target is force_tolerance): the last step need not be solved to 1e-3.
+    const double eta = std::min(options_.forcing_max,
+                                std::max(std::sqrt(gmax), 0.5 * options.force_tolerance / gmax));
     // After a failed line search: one preconditioned steepest-descent step.
     Eigen::VectorXd d =
-        failures > 0 ? Eigen::VectorXd(-precondition(cur.g))
-                     : newton_direction(cur.g, std::min(options_.forcing_max, std::sqrt(gmax)));
+        failures > 0 ? Eigen::VectorXd(-precondition(cur.g)) : newton_direction(cur.g, eta);
     cur.dphi = cur.g.dot(d);
     if (!(cur.dphi < 0.0)) {
       d = -precondition(cur.g);
