@@ -223,6 +223,11 @@ TEST(MessMemory, EstimateIsFixedPlusPerNodePlusDenseMagnetization) {
   EXPECT_EQ(spec.geometry.node_count(), 3700);
   EXPECT_EQ(mc::estimated_memory_bytes(spec), mc::kFixedBytes + 3700 * mc::kBytesPerNode + 32 * 36);
   EXPECT_NO_THROW(mc::check_memory(spec, {mc::estimated_memory_bytes(spec), "test"}));
+  // The Newton solver's matrix and multigrid need their own, larger figure per node.
+  mc::MessSpec newton = spec;
+  newton.solver.method = mc::SolverMethod::newton;
+  EXPECT_EQ(mc::estimated_memory_bytes(newton),
+            mc::kFixedBytes + 3700 * mc::kNewtonBytesPerNode + 32 * 36);
   EXPECT_NO_THROW(mc::check_memory(spec, {std::nullopt, "unknown"}));
   try {
     mc::check_memory(spec, {1'000'000, "test"});

@@ -57,11 +57,15 @@ std::string mib(std::int64_t bytes) {
 
 }  // namespace
 
+std::int64_t bytes_per_node(const MessSpec& spec) {
+  return spec.solver.method == SolverMethod::newton ? kNewtonBytesPerNode : kBytesPerNode;
+}
+
 std::int64_t estimated_memory_bytes(const MessSpec& spec) {
   const auto nodes = static_cast<double>(spec.geometry.node_count());
   const auto dim = 3.0 * static_cast<double>(spec.geometry.particle_count());
   const double bytes = static_cast<double>(kFixedBytes) +
-                       static_cast<double>(kBytesPerNode) * nodes + 4.0 * 8.0 * dim * dim;
+                       static_cast<double>(bytes_per_node(spec)) * nodes + 4.0 * 8.0 * dim * dim;
   const auto top = static_cast<double>(std::numeric_limits<std::int64_t>::max());
   return bytes >= top ? std::numeric_limits<std::int64_t>::max() : static_cast<std::int64_t>(bytes);
 }
@@ -96,7 +100,7 @@ void check_memory(const MessSpec& spec, const AvailableMemory& available) {
       "({}) or lower model.discretization_order = {}; MRESIM_MEMORY_LIMIT (bytes) overrides "
       "the available figure",
       g.shape.nx(), g.shape.ny(), g.shape.nz(), g.node_count(), g.particle_count(), mib(need),
-      mib(kFixedBytes), kBytesPerNode, mib(*available.bytes), available.source,
+      mib(kFixedBytes), bytes_per_node(spec), mib(*available.bytes), available.source,
       regular ? "particles.volume_fraction higher or count_per_axis lower" : "box.size",
       spec.lattice.discretization_order));
 }

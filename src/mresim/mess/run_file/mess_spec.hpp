@@ -272,10 +272,17 @@ MessSpec read_mess_run_file(const config::TableReader& root);
 // springs, cells, forces, the minimiser's history and the checkpoint copy together; the slope of
 // peak RSS between an 18,081- and a 58,621-node run is 1,513 bytes), rounded up.
 inline constexpr std::int64_t kBytesPerNode = 1600;
+// The same with solver.method = "newton": the elastic Hessian's sparse matrix (81 entries per
+// row, 2.9 kB per node) and the multigrid built on it come on top; measured peak RSS 311 MiB at
+// 48,600 nodes and 1,696 MiB at 284,592 nodes (the full-size Fig. 4.11 pair), a slope of
+// 6,150 bytes per node, rounded up.
+inline constexpr std::int64_t kNewtonBytesPerNode = 6400;
+// The per-node figure for the spec's solver.
+std::int64_t bytes_per_node(const MessSpec& spec);
 // The process itself (libraries, HDF5, buffers): peak RSS of the 1,800-node run is 20 MB.
 inline constexpr std::int64_t kFixedBytes = 32LL << 20;
 
-// kFixedBytes + kBytesPerNode x nodes + the magnetization solve's dense 3N x 3N matrices
+// kFixedBytes + bytes_per_node x nodes + the magnetization solve's dense 3N x 3N matrices
 // (Hessian, its factorization, the eigen-decomposition and Anderson's history: 4 x 8 (3N)^2
 // bytes for N particles).
 std::int64_t estimated_memory_bytes(const MessSpec& spec);
