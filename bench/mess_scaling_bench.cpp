@@ -50,11 +50,12 @@ mess::MessSystem make_system(const mess::ModelProfile& profile, int order) {
   const int side = odd_cells(kSide);
   const int height = odd_cells(kHeight);
   const int half_gap = static_cast<int>(std::lround(0.5 * kSeparation / l_e));
+  const int centre_cell = side / 2;
+  const double middle = (centre_cell + 0.5) * l_e;  // the centre cell's centre
   lat::ByHandPlacement placement;
   placement.box.lengths = Eigen::Vector3d(side, side, height) * l_e;
   for (const int k : {height / 2 - half_gap, height / 2 + half_gap}) {
-    placement.positions.emplace_back((side / 2 + 0.5) * l_e, (side / 2 + 0.5) * l_e,
-                                     (k + 0.5) * l_e);
+    placement.positions.emplace_back(middle, middle, (k + 0.5) * l_e);
   }
   spec.placement = placement;
   mess::MessSystem sys = mess::MessSystem::make(
@@ -119,7 +120,10 @@ void print(int order, std::int64_t nodes, const char* method, const Outcome& o) 
 
 // Least-squares slope of log t against log N.
 double exponent(const std::vector<double>& nodes, const std::vector<double>& seconds) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  double sx = 0.0;
+  double sy = 0.0;
+  double sxx = 0.0;
+  double sxy = 0.0;
   const auto n = static_cast<double>(nodes.size());
   for (std::size_t k = 0; k < nodes.size(); ++k) {
     const double x = std::log(nodes[k]);

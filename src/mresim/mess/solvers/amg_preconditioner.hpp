@@ -43,8 +43,8 @@ class AmgPreconditioner {
                     const AmgOptions& options = {});
   AmgPreconditioner(const AmgPreconditioner&) = delete;
   AmgPreconditioner& operator=(const AmgPreconditioner&) = delete;
-  AmgPreconditioner(AmgPreconditioner&&) noexcept;
-  AmgPreconditioner& operator=(AmgPreconditioner&&) noexcept;
+  AmgPreconditioner(AmgPreconditioner&& other) noexcept;
+  AmgPreconditioner& operator=(AmgPreconditioner&& other) noexcept;
   ~AmgPreconditioner();
 
   // out = one V-cycle applied to in (both 3N).

@@ -338,29 +338,28 @@ void VolumeKernel::add_hessian_blocks(const lattice::Lattice& lat, const Eigen::
   // The averaged edge vectors of each unit direction (vertex l, axis b): the same for every
   // cell, as the edge averaging is linear.
   std::array<lattice::EdgeVectors, 24> unit_edges;
-  for (int l = 0; l < 8; ++l) {
-    for (int b = 0; b < 3; ++b) {
-      lattice::CellVertices unit;
-      for (int k = 0; k < 8; ++k) unit[k] = Eigen::Vector3d::Zero();
-      unit[l][b] = 1.0;
-      unit_edges[static_cast<std::size_t>(3 * l + b)] = lattice::averaged_edge_vectors(unit);
-    }
+  for (std::size_t column = 0; column < unit_edges.size(); ++column) {
+    lattice::CellVertices unit;
+    for (int k = 0; k < 8; ++k) unit[k] = Eigen::Vector3d::Zero();
+    unit[column / 3][static_cast<Eigen::Index>(column % 3)] = 1.0;
+    unit_edges[column] = lattice::averaged_edge_vectors(unit);
   }
   Eigen::Matrix<double, 24, 24> cell;
   for (const auto& element : lat.elements) {
     const lattice::EdgeVectors e = lattice::averaged_edge_vectors(gather_vertices(element, x));
     // Column (l, b) of the cell's block: its product with the unit vector of that coordinate.
-    for (int column = 0; column < 24; ++column) {
+    for (Eigen::Index column = 0; column < 24; ++column) {
       const std::array<Eigen::Vector3d, 3> t = cell_hessian_terms(
           e, unit_edges[static_cast<std::size_t>(column)], lat.polymer.kappa, v0, force_factor);
-      for (int k = 0; k < 8; ++k) {
-        const Eigen::Vector3d s = vertex_signs(k);
+      for (Eigen::Index k = 0; k < 8; ++k) {
+        const Eigen::Vector3d s = vertex_signs(static_cast<int>(k));
         cell.block<3, 1>(3 * k, column) = s[0] * t[0] + s[1] * t[1] + s[2] * t[2];
       }
     }
-    for (int k = 0; k < 8; ++k) {
-      for (int l = 0; l < 8; ++l) {
-        sink.add(element[k], element[l], cell.block<3, 3>(3 * k, 3 * l));
+    for (Eigen::Index k = 0; k < 8; ++k) {
+      for (Eigen::Index l = 0; l < 8; ++l) {
+        sink.add(element[static_cast<std::size_t>(k)], element[static_cast<std::size_t>(l)],
+                 cell.block<3, 3>(3 * k, 3 * l));
       }
     }
   }
