@@ -176,14 +176,24 @@ InnerResult NewtonSolver::run(Objective& f, Eigen::VectorXd& u, int budget,
   int stalled = 0;
   int failures = 0;
   double best_gradient = cur.g.cwiseAbs().maxCoeff();
+  // The largest coordinate change of a step (units of l_e), like a trust radius: max_step at
+  // first, grown by half (up to kStepGrowth max_step) after a step that the cap cut short and that
+  // was accepted whole, halved (down to max_step) after one the line search had to shorten. A pair
+  // snapping into contact moves ~10 l_e, which steps of 0.2 l_e would take 50 Newton steps for.
+  constexpr double kStepGrowth = 16.0;
+  double step_cap = options.max_step;
+  bool capped = false;  // the last step was cut short by the cap: its direction was far off
   while (r.iterations < budget) {
     update_centre_hessian();
     const double gmax = cur.g.cwiseAbs().maxCoeff();
     // CG's relative residual: sqrt(|g|) for superlinear convergence, but no tighter than what
     // takes the forces to half the tolerance (the scaled gradient is in units of the force
     // scale, so the target is force_tolerance): the last step need not be solved to 1e-3.
-    const double eta = std::min(options_.forcing_max,
-                                std::max(std::sqrt(gmax), 0.5 * options.force_tolerance / gmax));
+    // While the steps are cut short by the cap, an accurate direction is wasted: 0.5.
+    const double eta =
+        capped ? 0.5
+               : std::min(options_.forcing_max,
+                          std::max(std::sqrt(gmax), 0.5 * options.force_tolerance / gmax));
     // After a failed line search: one preconditioned steepest-descent step.
     Eigen::VectorXd d =
         failures > 0 ? Eigen::VectorXd(-precondition(cur.g)) : newton_direction(cur.g, eta);
@@ -192,7 +202,7 @@ InnerResult NewtonSolver::run(Objective& f, Eigen::VectorXd& u, int budget,
       d = -precondition(cur.g);
       cur.dphi = cur.g.dot(d);
     }
-    const double alpha_max = options.max_step / d.cwiseAbs().maxCoeff();
+    const double alpha_max = step_cap / d.cwiseAbs().maxCoeff();
     LinePoint next;
     const bool ok = wolfe_line_search(f, u, d, cur, 1.0, alpha_max, use_energy, next);
     ++r.iterations;
@@ -205,6 +215,12 @@ InnerResult NewtonSolver::run(Objective& f, Eigen::VectorXd& u, int budget,
       continue;
     }
     failures = 0;
+    capped = alpha_max < 1.0 && next.alpha >= alpha_max;
+    if (capped) {
+      step_cap = std::min(1.5 * step_cap, kStepGrowth * options.max_step);
+    } else if (next.alpha < 0.5 * std::min(1.0, alpha_max)) {
+      step_cap = std::max(0.5 * step_cap, options.max_step);
+    }
     u += next.alpha * d;
     r.energy_change = next.phi - cur.phi;
     cur = std::move(next);
