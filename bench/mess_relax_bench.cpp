@@ -15,6 +15,7 @@
 #include "mresim/core/constants.hpp"
 #include "mresim/mess/lattice/lattice.hpp"
 #include "mresim/mess/profile/model_profile.hpp"
+#include "mresim/mess/protocols/loading.hpp"
 #include "mresim/mess/solvers/leapfrog.hpp"
 #include "mresim/mess/solvers/minimiser.hpp"
 
@@ -78,13 +79,9 @@ mess::MessSystem make_system(const Problem& p) {
   spec.placement = placement;
   mess::MessSystem sys =
       mess::MessSystem::make(lat::build_lattice(spec), p.field_tesla / mresim::kMu0, p.profile);
-  const lat::Lattice& l = sys.lattice();
-  mess::BoundaryConstraints c = mess::BoundaryConstraints::none(l.node_count());
-  for (const lat::Face f : {lat::Face::left, lat::Face::right, lat::Face::front, lat::Face::back,
-                            lat::Face::bottom, lat::Face::top}) {
-    c.fix_face(l.shape, f, l.positions);
-  }
-  sys.set_constraints(c);
+  // The hysteresis runs' boundary condition: all six faces held.
+  sys.set_constraints(
+      mresim::mess_protocol::hysteresis_load(sys.lattice(), sys.lattice().positions).constraints);
   return sys;
 }
 
@@ -162,9 +159,9 @@ class RatioReporter : public benchmark::ConsoleReporter {
       }
     }
     std::printf(
-        "  (differences of ~1e-3 l_e come from the magnetization tolerance: M is solved to "
-        "atol 1e-3, rtol 5e-3 in both,\n   and each method ends somewhere in that band; with "
-        "tight M tolerances they agree to 1e-7 l_e, see tests/mess/solvers/relaxation_test.cpp)\n");
+        "  (M is solved tightly, atol = rtol = 1e-12, in every method; with the original's "
+        "band, [solver.magnetization]\n   tolerance = \"original\", the states differed by up "
+        "to ~1e-3 l_e, each method ending somewhere in that band)\n");
   }
 
  private:

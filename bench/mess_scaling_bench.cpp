@@ -23,6 +23,7 @@
 #include "mresim/core/constants.hpp"
 #include "mresim/mess/lattice/lattice.hpp"
 #include "mresim/mess/profile/model_profile.hpp"
+#include "mresim/mess/protocols/loading.hpp"
 #include "mresim/mess/solvers/minimiser.hpp"
 
 namespace {
@@ -60,13 +61,9 @@ mess::MessSystem make_system(const mess::ModelProfile& profile, int order) {
   spec.placement = placement;
   mess::MessSystem sys = mess::MessSystem::make(
       lat::build_lattice(spec), Eigen::Vector3d(0.0, 0.0, kField) / mresim::kMu0, profile);
-  const lat::Lattice& l = sys.lattice();
-  mess::BoundaryConstraints c = mess::BoundaryConstraints::none(l.node_count());
-  for (const lat::Face f : {lat::Face::left, lat::Face::right, lat::Face::front, lat::Face::back,
-                            lat::Face::bottom, lat::Face::top}) {
-    c.fix_face(l.shape, f, l.positions);
-  }
-  sys.set_constraints(c);
+  // The hysteresis runs' boundary condition: all six faces held.
+  sys.set_constraints(
+      mresim::mess_protocol::hysteresis_load(sys.lattice(), sys.lattice().positions).constraints);
   return sys;
 }
 

@@ -6,6 +6,18 @@
 
 namespace mresim::mess::detail {
 
+bool StallGuard::stalled(const Eigen::VectorXd& g, double change, const Objective& f,
+                         bool use_energy) {
+  const double gmax = g.cwiseAbs().maxCoeff();
+  const double noise = 64.0 * std::numeric_limits<double>::epsilon() * f.magnitude();
+  if (gmax < best_gradient_ || (use_energy && change < -noise)) {
+    best_gradient_ = std::min(best_gradient_, gmax);
+    count_ = 0;
+    return false;
+  }
+  return ++count_ >= limit_;
+}
+
 bool wolfe_line_search(Objective& f, const Eigen::VectorXd& u, const Eigen::VectorXd& d,
                        LinePoint start, double alpha_init, double alpha_max, bool use_energy,
                        LinePoint& out) {

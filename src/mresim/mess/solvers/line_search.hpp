@@ -17,6 +17,23 @@ struct InnerResult {
   double energy_change = 0.0;  // scaled
 };
 
+// Ends an inner minimisation that no longer makes progress: `limit` iterations in a row
+// without a new smallest gradient component and (when energies are used) without an energy
+// decrease beyond the potential's rounding noise (64 eps times its magnitude).
+class StallGuard {
+ public:
+  StallGuard(const Eigen::VectorXd& g, int limit)
+      : best_gradient_(g.cwiseAbs().maxCoeff()), limit_(limit) {}
+  // After an accepted iteration with gradient g and energy change `change` (scaled): true
+  // when it is stalled.
+  bool stalled(const Eigen::VectorXd& g, double change, const Objective& f, bool use_energy);
+
+ private:
+  double best_gradient_;
+  int limit_;
+  int count_ = 0;
+};
+
 struct LinePoint {
   double alpha = 0.0;
   double phi = 0.0;   // scaled potential

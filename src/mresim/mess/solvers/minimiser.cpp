@@ -82,6 +82,7 @@ using detail::ForceMeasure;
 using detail::InnerResult;
 using detail::LinePoint;
 using detail::Objective;
+using detail::StallGuard;
 using detail::wolfe_line_search;
 
 // -------------------------------------------------------------------------------- L-BFGS
@@ -159,8 +160,7 @@ InnerResult run_lbfgs(Objective& f, Eigen::VectorXd& u, int budget, const Minimi
   }
   int failures = 0;
   constexpr int kStallIterations = 50;
-  int stalled = 0;
-  double best_gradient = cur.g.cwiseAbs().maxCoeff();
+  StallGuard guard(cur.g, kStallIterations);
   while (r.iterations < budget) {
     Eigen::VectorXd d = -memory.times(cur.g, P);
     cur.dphi = cur.g.dot(d);
@@ -193,13 +193,7 @@ InnerResult run_lbfgs(Objective& f, Eigen::VectorXd& u, int budget, const Minimi
     r.energy_change = next.phi - cur.phi;
     memory.add(std::move(s), std::move(y), opt.lbfgs_memory);
     cur = std::move(next);
-    // Stall guard: no energy decrease beyond rounding and no new smallest gradient for a while.
-    const double gmax = cur.g.cwiseAbs().maxCoeff();
-    const double noise = 64.0 * std::numeric_limits<double>::epsilon() * f.magnitude();
-    if (gmax < best_gradient || (use_energy && r.energy_change < -noise)) {
-      best_gradient = std::min(best_gradient, gmax);
-      stalled = 0;
-    } else if (++stalled >= kStallIterations) {
+    if (guard.stalled(cur.g, r.energy_change, f, use_energy)) {
       r.status = MinimiserStatus::stalled;
       return r;
     }

@@ -173,9 +173,8 @@ InnerResult NewtonSolver::run(Objective& f, Eigen::VectorXd& u, int budget,
     return r;
   }
   constexpr int kStallIterations = 20;
-  int stalled = 0;
+  StallGuard guard(cur.g, kStallIterations);
   int failures = 0;
-  double best_gradient = cur.g.cwiseAbs().maxCoeff();
   // The largest coordinate change of a step (units of l_e), like a trust radius: max_step at
   // first, grown by half (up to kStepGrowth max_step) after a step that the cap cut short and that
   // was accepted whole, halved (down to max_step) after one the line search had to shorten. A pair
@@ -224,12 +223,7 @@ InnerResult NewtonSolver::run(Objective& f, Eigen::VectorXd& u, int budget,
     u += next.alpha * d;
     r.energy_change = next.phi - cur.phi;
     cur = std::move(next);
-    const double g_next = cur.g.cwiseAbs().maxCoeff();
-    const double noise = 64.0 * std::numeric_limits<double>::epsilon() * f.magnitude();
-    if (g_next < best_gradient || (use_energy && r.energy_change < -noise)) {
-      best_gradient = std::min(best_gradient, g_next);
-      stalled = 0;
-    } else if (++stalled >= kStallIterations) {
+    if (guard.stalled(cur.g, r.energy_change, f, use_energy)) {
       r.status = MinimiserStatus::stalled;
       return r;
     }
