@@ -85,8 +85,11 @@ void NewtonSolver::finish() {
 }
 
 void NewtonSolver::update_centre_hessian() {
-  const Stopwatch watch(timings_.centre_hessian);
-  centre_hessian_ = system_.reduced_centre_hessian();
+  {
+    const Stopwatch watch(timings_.centre_hessian);
+    centre_hessian_ = system_.reduced_centre_hessian();
+  }
+  update_woodbury();
 }
 
 Eigen::VectorXd NewtonSolver::hessian_product(const Eigen::VectorXd& v) const {
@@ -116,6 +119,49 @@ Eigen::VectorXd NewtonSolver::hessian_product(const Eigen::VectorXd& v) const {
 }
 
 Eigen::VectorXd NewtonSolver::precondition(const Eigen::VectorXd& r) const {
+  Eigen::VectorXd z = elastic_precondition(r);
+  if (woodbury_w_.cols() == 0) return z;
+  // Woodbury: (A + U K U^T)^-1 ~ B - B U (I + K U^T B U)^-1 K U^T B, B the V-cycle.
+  const Eigen::VectorXd uz = centre_directions_.transpose() * z;
+  z -= woodbury_w_ * woodbury_c_.solve(centre_stiffness_ * uz);
+  return z;
+}
+
+void NewtonSolver::update_woodbury() {
+  const Eigen::Index columns = centre_hessian_.cols();
+  woodbury_w_.resize(0, 0);
+  if (columns == 0) return;
+  if (centre_directions_.cols() != columns) {
+    // U: column (p, a) = reduce() of a unit centre force spread as 1/n_p over the particle's
+    // nodes, so that H's centre part is U K' U^T with K' = K_c / (F0 l_e).
+    centre_directions_ = Eigen::MatrixXd::Zero(map_.size(), columns);
+    const auto& particles = system_.lattice().particle_nodes;
+    for (Eigen::Index c = 0; c < columns; ++c) {
+      Eigen::Matrix3Xd spread = Eigen::Matrix3Xd::Zero(3, system_.node_count());
+      const auto& nodes = particles[static_cast<std::size_t>(c / 3)];
+      for (const std::int32_t n : nodes) {
+        spread(c % 3, n) = 1.0 / static_cast<double>(nodes.size());
+      }
+      centre_directions_.col(c) = map_.reduce(spread);
+    }
+  }
+  // Only K's positive part (the stiff contact), so that the preconditioner stays positive
+  // definite where the attraction makes H indefinite.
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(centre_hessian_ /
+                                                             (force_scale_ * map_.length_scale()));
+  const Eigen::VectorXd positive = eigen.eigenvalues().cwiseMax(0.0);
+  if (!(positive.maxCoeff() > 0.0)) return;
+  centre_stiffness_ =
+      eigen.eigenvectors() * positive.asDiagonal() * eigen.eigenvectors().transpose();
+  woodbury_w_.resize(map_.size(), columns);
+  for (Eigen::Index c = 0; c < columns; ++c) {
+    woodbury_w_.col(c) = elastic_precondition(centre_directions_.col(c));
+  }
+  woodbury_c_.compute(Eigen::MatrixXd::Identity(columns, columns) +
+                      centre_stiffness_ * (centre_directions_.transpose() * woodbury_w_));
+}
+
+Eigen::VectorXd NewtonSolver::elastic_precondition(const Eigen::VectorXd& r) const {
   const Eigen::Index own = map_.own_dofs();
   Eigen::VectorXd nodes = Eigen::VectorXd::Zero(pc_->matrix->rows());
   for (Eigen::Index k = 0; k < own; ++k) nodes[map_.coordinate_of(k)] = r[k];

@@ -19,9 +19,9 @@
 //
 // Preconditioner: one GAMG V-cycle on the elastic Hessian (the coordinates that are dofs of
 // their own; held coordinates and rigid-group nodes decoupled as identity), plus Jacobi for
-// the rigid groups' translations. Built once per minimise() call at its starting positions
-// and kept for all its Newton steps; the magnetic low-rank term is left to CG (3 N_p extra
-// directions at most).
+// the rigid groups' translations, corrected by the positive part of the centre term (the stiff
+// WCA contact) with the Woodbury identity. The multigrid is built once per run (NewtonCache);
+// the correction once per Newton step (3 N_p V-cycles).
 //
 // The Hessian is always the conservative one (centres = mean of all particle nodes). With the
 // seed's CentreRule::centre_voxel, whose forces are not exactly a gradient, minimise() runs
@@ -30,6 +30,8 @@
 // the slope-only line search.
 
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -107,6 +109,10 @@ class NewtonSolver {
 
  private:
   void build_preconditioner();
+  // One V-cycle on the elastic part (plus Jacobi on the rigid groups).
+  Eigen::VectorXd elastic_precondition(const Eigen::VectorXd& r) const;
+  // The centre term's positive part in the preconditioner, by the Woodbury identity.
+  void update_woodbury();
   // d ~ -H^-1 g by preconditioned CG to |r| <= eta |g|, truncated at negative curvature (then
   // the iterate so far, or the preconditioned steepest descent at the first direction).
   Eigen::VectorXd newton_direction(const Eigen::VectorXd& g, double eta);
@@ -116,6 +122,12 @@ class NewtonSolver {
   double force_scale_;
   NewtonOptions options_;
   Eigen::MatrixXd centre_hessian_;
+  // Woodbury (update_woodbury): U (dofs x 3 N_p), K'_+ = the positive part of
+  // K_c / (F0 l_e), W = B U and the capacitance I + K'_+ U^T W.
+  Eigen::MatrixXd centre_directions_;
+  Eigen::MatrixXd centre_stiffness_;
+  Eigen::MatrixXd woodbury_w_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> woodbury_c_;
   std::shared_ptr<NewtonCache> cache_;
   NewtonPreconditioner* pc_ = nullptr;  // cache_->current
   std::int64_t krylov_iterations_ = 0;
