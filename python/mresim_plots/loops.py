@@ -5,6 +5,11 @@ from matplotlib.lines import Line2D
 
 from .common import BRANCH_LINESTYLE, BRANCH_STYLE
 
+# The contact line of separation plots (S = 2R): behind the data (zorder 1; lines and markers
+# are drawn at 2), thin, dash-dotted (the critical-field lines are dashed) and light, so that
+# the markers of a pair in contact, which lie on it, stay visible.
+CONTACT_STYLE = dict(color="0.6", linestyle="-.", linewidth=0.8, zorder=1)
+
 
 def branch_segments(field, branch, values):
     """Yield (branch, x, y) per branch; each segment starts at the previous branch's last
@@ -41,9 +46,9 @@ def branch_style_legend(ax, branches, loc="lower right"):
 
 
 def critical_field_lines(ax, hc1, hc2, color=None, with_labels=True, alpha=1.0, shade=True):
-    """Dashed vertical lines at +-H_C1 and +-H_C2 and, when shade, the bistable field ranges
-    H_C1 < |B| < H_C2 in light grey (Figs. 2.2, 3.13)."""
-    specs = [(hc1, "0.45", r"$\pm H_{C1}$"), (hc2, "0.1", r"$\pm H_{C2}$")]
+    """Dashed vertical lines at +-mu0 H_C1 and +-mu0 H_C2 (in T, as the field axis) and, when
+    shade, the bistable field ranges H_C1 < |B| < H_C2 in light grey (Figs. 2.2, 3.13)."""
+    specs = [(hc1, "0.45", r"$\pm\mu_0 H_{C1}$"), (hc2, "0.1", r"$\pm\mu_0 H_{C2}$")]
     for value, default_color, name in specs:
         label = f"{name} = {value:.3g} T" if with_labels else None
         for sign in (1.0, -1.0):

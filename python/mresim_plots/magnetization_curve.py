@@ -7,6 +7,7 @@ import numpy as np
 
 from .common import BRANCH_STYLE, FIELD_LABEL, MAG_LABEL, PlotError, require
 from .loops import branch_segments, draw_loop
+from .typography import suptitle
 
 # Where each leg's number goes: (field as a fraction of B_max, offset in points), for an open
 # loop (Fig. 1.5) and for one whose legs coincide (Fig. 1.6).
@@ -41,7 +42,7 @@ def plot(run):
                for b, s in BRANCH_STYLE.items() if np.any(branch == b)]
     ax.legend(handles=handles, loc="lower right", fontsize=8)
     describe_material(ax, attrs)
-    run.suptitle(fig)
+    suptitle(run, fig)
     run.save(fig, "magnetization.png")
 
 

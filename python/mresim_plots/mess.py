@@ -2,17 +2,27 @@
 (Chapter 4; the results.h5 layout is in docs/outputs-3d.md).
 
 Figures:
-  every run      energies.png               energies by term (Fig. 4.14a-f), against B or,
-                                            for strain and stress runs, against the strain
+  every run      energies.png               energies by term against B (hysteresis,
+                                            magnetostriction) or against |B| at zero load
+                                            (strain, stress); mess_energies.py
                  particle_magnetization.png centres and M at the last step (Fig. 4.22)
                  lattice_cut.png            the deformed lattice in the y plane through the
                                             first particle centre at the last step (Fig. 4.12);
                                             only when node positions were written
   hysteresis,    separation_magnetization.png  smallest separation and M/Ms against B (Fig. 4.4)
-  magnetostriction
-  strain, stress energy_density_fit.png     energy density against strain per field, with the
-                                            fitted u = a x^2/2 + c (Fig. 4.14g; strain runs)
-                 modulus.png                G_eff / E_eff against |B| (Fig. 4.18)
+  magnetostriction  magnetostriction.png    box strain along the field against B, when
+                                            /steps/magnetostriction is not zero throughout
+                                            (mess_magnetostriction.py)
+  strain, stress energies_vs_strain.png     per field, each energy term's change from zero
+                                            strain against the strain (Figs. 4.14-4.17 a-f;
+                                            mess_energies.py)
+                 pair_orientation.png       closest pair's separation and angle to the field
+                                            against the strain (mess_pair_orientation.py)
+                 energy_density_fit.png     energy density against strain per field, with the
+                                            fitted u = a x^2/2 + c and, after a kink, the
+                                            second fit (Figs. 4.14g, 4.26; strain runs)
+                 modulus.png                G_eff / E_eff against |B|, the second fit's modulus
+                                            as a second series (Figs. 4.18, 4.25)
                  mr_effect.png              (modulus / modulus at the first field - 1) x 100 %
   stress         stress_strain.png          applied stress against measured strain, with the
                                             fitted slope
@@ -30,6 +40,8 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Circle
 
 from .common import BRANCH_LINESTYLE, MAG_LABEL, PlotError, case_colors
+from .loops import CONTACT_STYLE
+from .typography import UM_PAREN, suptitle, typeset
 
 # The energy terms are the system's list (src/mresim/mess/terms/energy_term.hpp): results.h5
 # lists them in /steps/energies@terms and gives each dataset its `title` and `equation`.
@@ -68,17 +80,23 @@ LOAD_RUN_TYPES = ("mess_strain", "mess_stress")
 
 
 def plot(run):
+    # The figure modules import this one: imported here, not at the top.
+    from . import mess_energies, mess_magnetostriction, mess_pair_orientation
+
     data = MessData(run)
-    energies(run, data)
+    mess_energies.energies(run, data)
     if data.load_run:
+        mess_energies.energies_vs_strain(run, data)
         if run.run_type == "mess_stress":
             stress_strain(run, data)
         energy_density_fit(run, data)
         if data.has_analysis:  # an unfinished or failed analysis: the curves alone
             modulus(run, data)
             mr_effect(run, data)
+        mess_pair_orientation.pair_orientation(run, data)
     else:
         separation_magnetization(run, data)
+        mess_magnetostriction.magnetostriction(run, data)
     particle_magnetization(run, data)
     lattice_cut(run, data)
 
@@ -120,6 +138,10 @@ class MessData:
                     self.energy_order = _text(s["energies"].attrs["terms"]).split(",")
             self.energy_density = _array(s, "energy_density", None)
             self.separation = _array(s, "separation", None)
+            # Written by newer runs (docs/outputs-3d.md); None when absent.
+            self.pair_angle = _array(s, "pair_angle", None)  # rad, closest pair vs field
+            self.magnetostriction = _array(s, "magnetostriction", None)  # box strain along B
+            self.box_strain = _array(s, "box_strain", None)  # S x 3
             self.m_along = _array(s, "magnetization_projection", None)
             self.centres = _array(s, "centres", None)
             self.magnetization = _array(s, "magnetization", None)
@@ -153,6 +175,7 @@ class MessData:
             mr_default = self.fit_valid & (self.fit_valid[:1] if fields else self.fit_valid)
             self.mr_valid = _array(a, "mr_effect_valid", mr_default).astype(bool) \
                 & np.isfinite(self.mr_effect)
+            self.second = SecondFit(a, fields)
             self.last_positions = self._last_positions(f)
         ms = run.config.get("particles", {}).get("saturation_magnetization", DEFAULT_MS)
         self.ms = float(ms)
@@ -280,15 +303,15 @@ def separation_magnetization(run, data):
     top = ax  # the legend goes on the axes drawn last, or the twin's lines cover it
     if data.separation is not None:
         draw_legs(ax, b_mt, leg, data.separation * 1e6, SEPARATION_COLOR, marker="o")
-        ax.set_ylabel(r"smallest centre separation ($\mu$m)", color=SEPARATION_COLOR)
+        ax.set_ylabel(f"smallest centre separation {UM_PAREN}", color=SEPARATION_COLOR)
         ax.tick_params(axis="y", colors=SEPARATION_COLOR)
         handles.append(Line2D([], [], color=SEPARATION_COLOR, marker="o", markersize=3,
                               label="separation"))
         contact = 2.0 * data.radius * 1e6
         if math.isfinite(contact) and np.nanmin(data.separation) * 1e6 < 1.5 * contact:
-            ax.axhline(contact, color=SEPARATION_COLOR, linestyle=":", linewidth=0.9)
-            handles.append(Line2D([], [], color=SEPARATION_COLOR, linestyle=":",
-                                  label=r"contact, $2R$"))
+            ax.axhline(contact, **CONTACT_STYLE)
+            handles.append(Line2D([], [], label=r"contact, $S = 2R$",
+                                  **{k: v for k, v in CONTACT_STYLE.items() if k != "zorder"}))
     if data.m_along is not None:
         ax2 = top = ax.twinx() if data.separation is not None else ax
         draw_legs(ax2, b_mt, leg, data.m_along, MAGNETIZATION_COLOR, marker="s")
@@ -302,126 +325,57 @@ def separation_magnetization(run, data):
     ax.set_xlabel(FIELD_MT_LABEL)
     ax.grid(alpha=0.25)
     top.legend(handles=handles, fontsize=8, loc="best")
-    run.suptitle(fig)
+    suptitle(run, fig)
     run.save(fig, "separation_magnetization.png")
-
-
-# ---------------------------------------------------------------- energies
-
-def energy_panels(data):
-    """(dataset, panel title) in the system's term order, then the total."""
-    fallback = dict(ENERGY_PANELS)
-    order = data.energy_order or [name for name, _ in ENERGY_PANELS if name != "total"]
-    panels = [(name, data.energy_titles.get(name, fallback.get(name, name))) for name in order
-              if name in data.energies and name != "self_linearized"]
-    if "total" in data.energies:
-        panels.append(("total", "total"))
-    return panels
-
-
-def energies(run, data):
-    """Energies by term (J): against B for field sweeps, against the strain per field for
-    strain and stress runs (Fig. 4.14a-f)."""
-    panels = energy_panels(data)
-    if not panels:
-        return
-    ncols = 4 if len(panels) > 6 else 3
-    nrows = math.ceil(len(panels) / ncols)
-    fig, axes = plt.subplots(nrows, ncols, squeeze=False, sharex=True,
-                             figsize=(3.3 * ncols + 0.4, 2.6 * nrows + 0.9), layout="constrained")
-    handles = []
-    if data.load_run:
-        groups = data.field_groups()
-        colors = case_colors(len(groups))
-        for ax, (name, title) in zip(axes.flat, panels):
-            for (k, steps), color in zip(groups, colors):
-                ax.plot(data.strain[steps], data.energies[name][steps], "o-", color=color,
-                        markersize=3, linewidth=1.0)
-                if name == "self" and "self_linearized" in data.energies:
-                    ax.plot(data.strain[steps], data.energies["self_linearized"][steps], "--",
-                            color=color, linewidth=0.8)
-        handles = [Line2D([], [], color=c, marker="o", markersize=3, label=data.field_label(k))
-                   for (k, _), c in zip(groups, colors)]
-        xlabel = strain_label(run, data)
-    else:
-        b_mt = data.b_along * 1e3
-        leg = legs(data.b_along)
-        for ax, (name, title) in zip(axes.flat, panels):
-            draw_legs(ax, b_mt, leg, data.energies[name], "C0", marker="o")
-            if name == "self" and "self_linearized" in data.energies:
-                draw_legs(ax, b_mt, leg, data.energies["self_linearized"], "C1")
-        if np.unique(leg).size > 1:
-            handles = leg_legend_handles(b_mt, leg)
-        xlabel = FIELD_MT_LABEL
-    if "self" in data.energies and "self_linearized" in data.energies:
-        style = dict(color="0.3", linestyle="--") if data.load_run else dict(color="C1")
-        handles.append(Line2D([], [], label="self: linearized, eq. 4.73 (reported only)",
-                              **style))
-    for ax, (name, title) in zip(axes.flat, panels):
-        ax.set_title(title, fontsize=9, loc="right")  # the y offset text is left
-        ax.grid(alpha=0.25)
-        ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 3), useMathText=True)
-        ax.tick_params(labelsize=8)
-    for ax in axes.flat[len(panels):]:
-        ax.set_visible(False)
-    for ax in axes[:, 0]:
-        ax.set_ylabel("energy (J)")
-    for i, ax in enumerate(axes.flat[:len(panels)]):
-        if i + ncols >= len(panels):
-            ax.set_xlabel(xlabel)
-            ax.xaxis.set_tick_params(labelbottom=True)
-    if handles:
-        _figure_legend(fig, handles)
-    run.suptitle(fig)
-    run.save(fig, "energies.png")
-
-
-def _figure_legend(fig, handles):
-    """A legend in a strip below the axes (matplotlib 3.6 has no loc='outside ...')."""
-    per_row = min(len(handles), 4)
-    rows = math.ceil(len(handles) / per_row)
-    strip = (0.1 + 0.22 * rows) / fig.get_figheight()
-    fig.get_layout_engine().set(rect=(0.0, strip, 1.0, 1.0 - strip))
-    fig.legend(handles=handles, loc="lower center", ncol=per_row, fontsize=8, frameon=False)
 
 
 # ---------------------------------------------------------------- strain and stress runs
 
 def energy_density_fit(run, data):
-    """Fig. 4.14g for every field on one axes: u - c against the strain (c, the fitted offset,
-    differs between fields by the magnetic energies), filled markers for the fitted points,
-    open for the points after the kink, the fitted parabola a x^2/2 over the fitted range."""
+    """Fig. 4.14g for every field on one axes: u - c against the strain (c, the first fit's
+    offset, differs between fields by the magnetic energies), filled circles for the points of
+    the first fit, filled squares for those of the second fit after a kink (Fig. 4.26: two
+    curves for one run), open circles for the points in neither; each fitted parabola over
+    its own points, both moduli in the legend."""
     if data.energy_density is None:
         return
     fig, ax = plt.subplots(figsize=(7.4, 5.0), layout="constrained")
     groups = data.field_groups()
     stress = run.run_type == "mess_stress"
     unit, scale = _modulus_unit(data)
-    unfitted = False
+    symbol = _modulus_symbol(data)
+    unfitted = second_drawn = False
     for (k, steps), color in zip(groups, case_colors(len(groups))):
         x, u = data.strain[steps], data.energy_density[steps]
         a = data.modulus[k] if k < data.modulus.size else math.nan
         c = data.offset[k] if k < data.offset.size else math.nan
-        first = int(data.first_point[k]) if k < data.first_point.size else 0
-        fitted = data.fit_points[k] if k < data.fit_points.size else -1
-        fitted = x.size - first if fitted < 0 else min(fitted, x.size - first)
-        in_fit = np.zeros(x.size, dtype=bool)
-        in_fit[first:first + fitted] = True
+        fitted = fit_mask(x.size, data.first_point[k] if k < data.first_point.size else 0,
+                          data.fit_points[k] if k < data.fit_points.size else -1)
         valid = bool(data.fit_valid[k]) if k < data.fit_valid.size else False
         fit_ok = not stress and valid and math.isfinite(a) and math.isfinite(c)
+        second = not stress and data.second.ok(k)
+        in_second = data.second.points(k, x.size) if second else np.zeros(x.size, dtype=bool)
         shift = c if fit_ok else np.nanmin(u)
         label = data.field_label(k)
         if fit_ok:
-            label += f": {_modulus_symbol(data)} = {a / scale:.3g} {unit}"
+            label += f": {symbol} = {a / scale:.3g} {unit}"
         elif not stress:
             label += ": no valid fit"
-        ax.plot(x[in_fit], u[in_fit] - shift, "o", color=color, markersize=4, label=label)
-        if not in_fit.all():
+        if second:
+            label += f"; after the kink {data.second.modulus[k] / scale:.3g} {unit}"
+        ax.plot(x[fitted], u[fitted] - shift, "o", color=color, markersize=4, label=label)
+        if second:
+            second_drawn = True
+            ax.plot(x[in_second], u[in_second] - shift, "s", color=color, markersize=4)
+            xs = np.linspace(np.min(x[in_second]), np.max(x[in_second]), 100)
+            ax.plot(xs, data.second.curve(k, xs) - shift, "--", color=color, linewidth=1.0)
+        rest = ~fitted & ~in_second
+        if np.any(rest):
             unfitted = True
-            ax.plot(x[~in_fit], u[~in_fit] - shift, "o", color=color, markersize=4,
+            ax.plot(x[rest], u[rest] - shift, "o", color=color, markersize=4,
                     markerfacecolor="none")
-        if fit_ok and fitted >= 2:
-            xs = np.linspace(np.min(x[in_fit]), np.max(x[in_fit]), 100)
+        if fit_ok and np.sum(fitted) >= 2:
+            xs = np.linspace(np.min(x[fitted]), np.max(x[fitted]), 100)
             ax.plot(xs, 0.5 * a * xs**2, "-", color=color, linewidth=1.0)
     handles, labels = ax.get_legend_handles_labels()
     if unfitted:
@@ -429,16 +383,72 @@ def energy_density_fit(run, data):
                               linestyle="none"))
         labels.append("not fitted (zero strain above the next point, or after the kink)")
     if not stress:
-        handles.append(Line2D([], [], color="0.3"))
-        labels.append(r"fit $u = a x^2/2 + c$")
+        handles.append(Line2D([], [], color="0.3", marker="o", markersize=4))
+        labels.append(r"fit $u = a x^2/2 + c$ and its points")
+    if second_drawn:
+        handles.append(Line2D([], [], color="0.3", linestyle="--", marker="s", markersize=4))
+        labels.append(f"second fit after the kink, {data.second.formula()}, and its points")
     ax.legend(handles, labels, fontsize=7, loc="upper left", ncol=2 if len(labels) > 8 else 1)
     ax.set_xlabel(strain_label(run, data))
     ax.set_ylabel(r"energy density $u - c$ (J/m$^3$)" if not stress
                   else r"energy density $u - u_{min}$ (J/m$^3$)")
     ax.axhline(0.0, color="0.8", linewidth=0.6, zorder=0)
     ax.grid(alpha=0.25)
-    run.suptitle(fig)
+    suptitle(run, fig)
     run.save(fig, "energy_density_fit.png")
+
+
+def fit_mask(n, first, count):
+    """The points of one field (n, in load order) that a fit used: `count` points from index
+    `first` (count < 0: all from `first`; /analysis/fit_points = -1 in old files)."""
+    first = max(int(first), 0)
+    count = n - first if count < 0 else min(int(count), n - first)
+    mask = np.zeros(n, dtype=bool)
+    mask[first:first + max(count, 0)] = True
+    return mask
+
+
+class SecondFit:
+    """The fit after a kink (/analysis/second_*, one entry per field; second_valid 0 and NaN
+    where a field has no kink or too few points after it). Everything that depends on the
+    fit's form is here: curve() and formula()."""
+
+    def __init__(self, a, fields):
+        self.present = a is not None and "second_modulus" in a
+        nan = np.full(fields, math.nan)
+        self.modulus = _array(a, "second_modulus", nan)
+        self.offset = _array(a, "second_offset", nan)
+        self.rms_residual = _array(a, "second_rms_residual", nan)
+        self.first_point = _array(a, "second_first_point", np.zeros(fields)).astype(int)
+        self.fit_points = _array(a, "second_fit_points", np.zeros(fields)).astype(int)
+        self.valid = _array(a, "second_valid", np.zeros(fields)).astype(bool)
+        # u = a x^2/2 + b x + c when the run stores b, else u = a x^2/2 + c.
+        self.slope = _array(a, "second_slope", None)
+        self.form = _text(a.attrs.get("second_form", "")) if a is not None else ""
+
+    def ok(self, k):
+        """Field k has a valid second fit with finite coefficients over at least 2 points."""
+        if not self.present or k >= min(self.modulus.size, self.offset.size, self.valid.size,
+                                         self.fit_points.size):
+            return False
+        return bool(self.valid[k]) and math.isfinite(self.modulus[k]) \
+            and math.isfinite(self.offset[k]) and self.fit_points[k] >= 2 \
+            and math.isfinite(self._b(k))
+
+    def points(self, k, n):
+        return fit_mask(n, self.first_point[k], self.fit_points[k])
+
+    def _b(self, k):
+        return float(self.slope[k]) if self.slope is not None and k < self.slope.size else 0.0
+
+    def curve(self, k, x):
+        """u(x) of field k's second fit, from the stored coefficients."""
+        return 0.5 * self.modulus[k] * x**2 + self._b(k) * x + self.offset[k]
+
+    def formula(self):
+        if self.form:
+            return self.form
+        return r"$u = a x^2/2 + b x + c$" if self.slope is not None else r"$u = a x^2/2 + c$"
 
 
 def stress_strain(run, data):
@@ -462,7 +472,7 @@ def stress_strain(run, data):
     ax.set_ylabel(f"applied stress ({data.load_unit or 'Pa'})")
     ax.grid(alpha=0.25)
     ax.legend(fontsize=7, loc="best")
-    run.suptitle(fig)
+    suptitle(run, fig)
     run.save(fig, "stress_strain.png")
 
 
@@ -487,19 +497,25 @@ INVALID_COLOR = "0.6"
 def modulus(run, data):
     """Fig. 4.18: the effective modulus against |B|. Invalid fits (too few points, an
     unconverged step, wrong curvature; /analysis/valid = 0) are drawn hollow and grey, apart
-    from the line through the valid ones."""
+    from the line through the valid ones. Fields with a valid second fit after a kink add its
+    modulus as a second series (Fig. 4.25 lists such a run twice)."""
     unit, scale = _modulus_unit(data)
     fig, ax = plt.subplots(figsize=(6.4, 4.8), layout="constrained")
     b_mt = data.field_magnitude * 1e3
     ok = data.fit_valid
     ax.plot(b_mt[ok], data.modulus[ok] / scale, "o-", color="C0", markersize=5,
-            label=_modulus_symbol(data))
+            label=_modulus_symbol(data) + (" (first fit)" if data.second.present else ""))
+    second = np.array([data.second.ok(k) for k in range(b_mt.size)], dtype=bool)
+    if np.any(second):
+        ax.plot(b_mt[second], data.second.modulus[second] / scale, "D", linestyle="none",
+                color="C1", markersize=5, label=_modulus_symbol(data) + " after the kink")
+        ax.legend(fontsize=8, loc="best")
     _draw_invalid(ax, b_mt, data.modulus / scale, ok)
     _note_missing(ax, b_mt, ok, "no valid fit")
     ax.set_xlabel(ABS_FIELD_LABEL)
     ax.set_ylabel(f"{_modulus_symbol(data)} ({unit})")
     ax.grid(alpha=0.25)
-    run.suptitle(fig)
+    suptitle(run, fig)
     run.save(fig, "modulus.png")
 
 
@@ -516,7 +532,7 @@ def mr_effect(run, data):
     ax.set_xlabel(ABS_FIELD_LABEL)
     ax.set_ylabel(f"MR effect of {_modulus_symbol(data)} (%)")
     ax.grid(alpha=0.25)
-    run.suptitle(fig)
+    suptitle(run, fig)
     run.save(fig, "mr_effect.png")
 
 
@@ -557,9 +573,9 @@ def particle_magnetization(run, data):
     ax3.scatter(c[:, 0], c[:, 1], c[:, 2], s=60, color="0.6", depthshade=False)
     ax3.quiver(c[:, 0], c[:, 1], c[:, 2], arrows[:, 0], arrows[:, 1], arrows[:, 2],
                color="C3", linewidth=1.5, arrow_length_ratio=0.3)
-    ax3.set_xlabel(r"$x$ ($\mu$m)")
-    ax3.set_ylabel(r"$y$ ($\mu$m)")
-    ax3.set_zlabel(r"$z$ ($\mu$m)")
+    ax3.set_xlabel(f"$x$ {UM_PAREN}")
+    ax3.set_ylabel(f"$y$ {UM_PAREN}")
+    ax3.set_zlabel(f"$z$ {UM_PAREN}")
     if data.box is not None and data.box.size == 3:
         lengths = data.box * 1e6
         ax3.set_xlim(0, lengths[0])
@@ -591,8 +607,8 @@ def particle_magnetization(run, data):
     ax.set_xlim(low[0], high[0])
     ax.set_ylim(low[1], high[1])
     ax.set_aspect("equal")
-    ax.set_xlabel(r"$x$ ($\mu$m)")
-    ax.set_ylabel(r"$z$ ($\mu$m)")
+    ax.set_xlabel(f"$x$ {UM_PAREN}")
+    ax.set_ylabel(f"$z$ {UM_PAREN}")
     ax.grid(alpha=0.25)
     b = data.field[-1]
     mean_m = np.mean(np.linalg.norm(m, axis=1))
@@ -601,7 +617,7 @@ def particle_magnetization(run, data):
         theta, phi = _angles(b)
         text += rf" ($\theta$ = {theta:.0f}°, $\varphi$ = {phi:.0f}°)"
     text += rf", mean $|M|/M_s$ = {mean_m:.3g}; arrows $2R\,M/M_s$"
-    fig.suptitle((run.title + "\n" if run.title else "") + text, fontsize=10)
+    fig.suptitle((typeset(run.title) + "\n" if run.title else "") + text, fontsize=10)
     run.save(fig, "particle_magnetization.png")
 
 

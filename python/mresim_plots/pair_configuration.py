@@ -8,6 +8,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.patches import Circle, Patch
 
+from .typography import UM, UM_PAREN, suptitle
+
 STYLES = [
     (dict(facecolor="0.85", edgecolor="0.45", linestyle="--"), "equilibrium"),
     (dict(facecolor="#4a7fc1", edgecolor="#1b3b6f", alpha=0.65), "displaced"),
@@ -30,7 +32,7 @@ def plot(run, cases):
             ax.set_title("\n".join(textwrap.wrap(case["label"], 50)), fontsize=9)
     for ax in axes.flat[n:]:
         ax.set_visible(False)
-    run.suptitle(fig)
+    suptitle(run, fig)
     run.save(fig, "configuration.png")
 
 
@@ -72,7 +74,7 @@ def draw_case(ax, case):
         ax.plot([a[0], b[0]], [a[1], b[1]], color=style["edgecolor"], linewidth=0.8,
                 marker=".", markersize=3)
         label = (f"B = {case['field'][i]:.2f} T ({word}), "
-                 f"$S$ = {case['s'][i] * 1e6:.2f} $\\mu$m, "
+                 f"$S$ = {case['s'][i] * 1e6:.2f} {UM}, "
                  f"$\\theta$ = {case['theta'][i]:.2f}$^\\circ$")
         handles.append(Patch(label=label, **style))
     xlim, zlim, arrow_middle = frame(case)
@@ -80,8 +82,8 @@ def draw_case(ax, case):
     ax.set_xlim(*xlim)
     ax.set_ylim(*zlim)
     ax.set_aspect("equal")
-    ax.set_xlabel(r"$x$ ($\mu$m)")
-    ax.set_ylabel(r"$z$ ($\mu$m)")
+    ax.set_xlabel(f"$x$ {UM_PAREN}")
+    ax.set_ylabel(f"$z$ {UM_PAREN}")
     ax.grid(alpha=0.2)
     ax.legend(handles=handles, loc="lower center", fontsize=7, framealpha=0.9)
 

@@ -5,6 +5,7 @@ import numpy as np
 
 from .common import BRANCH_STYLE, FIELD_LABEL, MAG_LABEL, PlotError, case_colors, require
 from .loops import branch_segments
+from .typography import suptitle, typeset
 
 WIDENING_LABEL = r"$\Delta(M/M_s)$"
 
@@ -29,7 +30,8 @@ def split_cases(summary):
     cases = []
     for index in np.unique(summary["case"]).astype(int):
         rows = summary["case"] == index
-        label = str(summary["label"][rows][0]) if "label" in summary else f"case {index}"
+        label = typeset(str(summary["label"][rows][0])) if "label" in summary \
+            else f"case {index}"
         cases.append(dict(index=index, label=label, field=summary["B_T"][rows],
                           branch=summary["branch"][rows].astype(int),
                           m=summary["M_over_Ms"][rows],
@@ -67,7 +69,7 @@ def first_quadrant(run, cases, colors):
     handles = [plt.Line2D([], [], color="0.3", linestyle=BRANCH_STYLE[b]["linestyle"],
                           label=BRANCH_STYLE[b]["label"]) for b in (1, 2)]
     ax.legend(handles=handles, fontsize=8, loc="center left", bbox_to_anchor=(0.0, 0.62))
-    run.suptitle(fig)
+    suptitle(run, fig)
     run.save(fig, "ensemble_first_quadrant.png")
 
 
@@ -116,7 +118,7 @@ def loop_widening(run, cases, colors, widening):
     ax.grid(alpha=0.25)
     title = "five-point average (raw: faint)" if smoothed else None
     ax.legend(fontsize=8, title=title, title_fontsize=8)
-    run.suptitle(fig)
+    suptitle(run, fig)
     run.save(fig, "loop_widening.png")
 
 
@@ -135,5 +137,5 @@ def susceptibility(run, cases, colors):
         ax.grid(alpha=0.25)
     axes[0, 0].set_ylabel(r"$d(M/M_s)/dB$ (1/T)")
     axes[0, 0].legend(fontsize=8, loc="lower center")
-    run.suptitle(fig)
+    suptitle(run, fig)
     run.save(fig, "susceptibility.png")

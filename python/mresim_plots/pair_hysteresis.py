@@ -8,11 +8,13 @@ import numpy as np
 
 from . import pair_configuration
 from .common import BRANCH_STYLE, FIELD_LABEL, MAG_LABEL, PlotError, case_colors, require
-from .loops import branch_style_legend, critical_field_lines, draw_loop
+from .loops import CONTACT_STYLE, branch_style_legend, critical_field_lines, draw_loop
+from .typography import UM_PAREN, suptitle, typeset
 
 COLUMNS = ["case", "branch", "B_T", "S_minus_S0_m", "S_m", "theta_deg", "M_over_Ms"]
-DISP_LABEL = r"$S - S_0$ ($\mu$m)"
+DISP_LABEL = f"$S - S_0$ {UM_PAREN}"
 ROT_LABEL = r"rotation $\theta$ (deg)"
+CONTACT_LABEL = r"contact, $S = 2R$"
 
 
 def plot(run):
@@ -40,7 +42,7 @@ def read_cases(run, summary):
             attrs = dict(f[f"cases/{index}"].attrs) if f"cases/{index}" in f else {}
             label = attrs.get("label") or (summary["label"][rows][0] if "label" in summary else "")
             case = dict(
-                index=index, label=str(label) or f"case {index}",
+                index=index, label=typeset(str(label)) or f"case {index}",
                 model=str(attrs.get("spring_model", "")),
                 angle=float(attrs.get("field_angle_deg", 0.0)),
                 s0=float(attrs.get("rest_separation_m", summary["S_m"][rows][0])),
@@ -81,7 +83,7 @@ def overlay(run, cases, key, ylabel, name, critical_lines=True, extra=None):
     ax.set_xlabel(FIELD_LABEL)
     ax.set_ylabel(ylabel)
     ax.grid(alpha=0.25)
-    run.suptitle(fig)
+    suptitle(run, fig)
     run.save(fig, name)
 
 
@@ -120,18 +122,19 @@ def displacement(run, cases):
         labels.append(style["label"])
     if any(c["hc"] for c in cases):
         handles.append(plt.Line2D([], [], color="0.3", linestyle="--", linewidth=0.9))
-        labels.append(r"$\pm H_{C1}$, $\pm H_{C2}$")
+        labels.append(r"$\pm\mu_0 H_{C1}$, $\pm\mu_0 H_{C2}$")
         handles.append(plt.Rectangle((0, 0), 1, 1, color="0.5", alpha=0.1, linewidth=0))
         labels.append("bistable range")
     if contact:
-        handles.append(plt.Line2D([], [], color="0.5", linestyle=":", linewidth=0.9))
-        labels.append(r"contact, $S = 2R$")
+        handles.append(plt.Line2D([], [], **{k: v for k, v in CONTACT_STYLE.items()
+                                             if k != "zorder"}))
+        labels.append(CONTACT_LABEL)
     # matplotlib 3.6 (Debian 12) has no loc="outside ...": keep a strip free at the bottom
     per_row = len(labels) if ncols == 3 else math.ceil(len(labels) / 2)
     strip = 0.2 * (1 + math.ceil(len(labels) / per_row)) / fig.get_figheight()
     fig.get_layout_engine().set(rect=(0.0, strip, 1.0, 1.0 - strip))
     fig.legend(handles, labels, loc="lower center", ncol=per_row, fontsize=8, frameon=False)
-    run.suptitle(fig)
+    suptitle(run, fig)
     run.save(fig, "displacement.png")
 
 
@@ -141,11 +144,11 @@ def _branch_styles(cases):
 
 
 def draw_contact(ax, case):
-    """Dotted line at surface contact (S = 2R) when the pair gets near it."""
+    """A light dashed line behind the loop at surface contact (S = 2R, S - S0 = 2R - S0) when
+    the pair gets near it."""
     contact_um = (2.0 * case["radius"] - case["s0"]) * 1e6
     if contact_um < 0 and np.min(case["disp"]) < 0.8 * contact_um:
-        ax.axhline(contact_um, color="0.5", linestyle=":", linewidth=0.9,
-                   label=r"contact, $S = 2R$")
+        ax.axhline(contact_um, label=CONTACT_LABEL, **CONTACT_STYLE)
         return True
     return False
 

@@ -5,11 +5,19 @@ import numpy as np
 from matplotlib.patches import Patch
 
 from .common import TAUPE, PlotError
+from .typography import UM_PAREN, suptitle
 
-S0_LABEL = r"$S_0$ ($\mu$m)"
+S0_LABEL = f"$S_0$ {UM_PAREN}"
 # (dataset, panel title, colourbar name)
-PANELS = [("HC1", r"$H_{C1}$", r"$H_{C1}$"), ("HC2", r"$H_{C2}$", r"$H_{C2}$"),
-          ("dH", r"$\Delta H = H_{C2} - H_{C1}$", r"$\Delta H$")]
+# The critical fields are stored as mu0 H (T), the field axis of the loops.
+PANELS = [("HC1", r"$\mu_0 H_{C1}$", r"$\mu_0 H_{C1}$"),
+          ("HC2", r"$\mu_0 H_{C2}$", r"$\mu_0 H_{C2}$"),
+          ("dH", r"$\mu_0 \Delta H = \mu_0 (H_{C2} - H_{C1})$", r"$\mu_0 \Delta H$")]
+# Optional per-point flag (summary.csv column, or /map dataset of the same name): 1 where dH
+# is resolved, 0 where it lies below the critical-field refinement tolerance, so that its
+# value is noise (the raggedness of Fig. 2.5). Such points are drawn hollow.
+DH_RESOLVED_COLUMN = "dH_resolved"
+UNRESOLVED_LABEL = r"hollow: $\mu_0 \Delta H$ below the critical-field tolerance"
 
 
 def plot(run):
@@ -29,12 +37,37 @@ def read_grid(run):
                     hysteresis=g["hysteresis"][()].astype(int) > 0,
                     **{key: g[key][()] for key, _, _ in PANELS})
         grid["threshold_h5"] = g["eq_2_10_threshold"][()] if "eq_2_10_threshold" in g else None
+        resolved_h5 = g[DH_RESOLVED_COLUMN][()] if DH_RESOLVED_COLUMN in g else None
     if grid["dH"].shape != (grid["rows"].size, grid["s0"].size):
         raise PlotError(f"/map/dH has shape {grid['dH'].shape}, expected rows x separations")
     grid["is_k"] = grid["param"] == "k"
     grid["row_label"] = r"$k$ (N/m)" if grid["is_k"] else r"field angle $\theta_H$ (deg)"
     grid["threshold"] = thresholds(run, grid)
+    grid["resolved"] = resolved_flags(run, grid, resolved_h5)
     return grid
+
+
+def resolved_flags(run, grid, from_h5=None):
+    """rows x separations booleans (True: dH resolved) from the DH_RESOLVED_COLUMN of
+    summary.csv (rows `row`, `col`) or the /map dataset; None when the run has neither."""
+    shape = grid["dH"].shape
+    if from_h5 is not None and np.shape(from_h5) == shape:
+        return np.asarray(from_h5) > 0
+    table = run.optional_table("summary.csv")
+    if table is None or not {DH_RESOLVED_COLUMN, "row", "col"} <= set(table):
+        return None
+    resolved = np.ones(shape, dtype=bool)
+    r, c = table["row"].astype(int), table["col"].astype(int)
+    inside = (r >= 0) & (r < shape[0]) & (c >= 0) & (c < shape[1])
+    resolved[r[inside], c[inside]] = table[DH_RESOLVED_COLUMN][inside] > 0
+    return resolved
+
+
+def unresolved(grid):
+    """Cells with hysteresis whose dH is below the tolerance (all False without the flag)."""
+    if grid.get("resolved") is None:
+        return np.zeros(grid["dH"].shape, dtype=bool)
+    return grid["hysteresis"] & ~grid["resolved"]
 
 
 def thresholds(run, grid):
@@ -75,6 +108,10 @@ def critical_fields_map(run, grid):
         if grid["threshold"] is not None:
             ax.plot(grid["threshold"], grid["rows"], color="w", linestyle="--", linewidth=1.2,
                     label="eq. 2.10 threshold")
+        if key == "dH" and np.any(unresolved(grid)):
+            rows, cols = np.nonzero(unresolved(grid))
+            ax.plot(grid["s0"][cols], grid["rows"][rows], "o", markersize=3.5, linestyle="none",
+                    markerfacecolor="none", markeredgecolor="w", markeredgewidth=0.8)
         ax.set_xlim(x_edges[0], x_edges[-1])
         ax.set_ylim(y_edges[0], y_edges[-1])
         ax.set_xlabel(S0_LABEL)
@@ -87,7 +124,14 @@ def critical_fields_map(run, grid):
         handles.append(plt.Line2D([], [], color="w", linestyle="--", label="eq. 2.10 threshold"))
     legend = axes[0].legend(handles=handles, loc="upper right", fontsize=8, framealpha=0.85)
     legend.get_frame().set_facecolor("0.55" if grid["threshold"] is not None else "w")
-    run.suptitle(fig)
+    if np.any(unresolved(grid)):
+        marker = plt.Line2D([], [], marker="o", markersize=3.5, linestyle="none",
+                            markerfacecolor="none", markeredgecolor="w", markeredgewidth=0.8,
+                            label=r"$\mu_0 \Delta H$ below the tolerance")
+        dh_legend = axes[2].legend(handles=[marker], loc="upper right", fontsize=8,
+                                   framealpha=0.85)
+        dh_legend.get_frame().set_facecolor("0.55")
+    suptitle(run, fig)
     run.save(fig, "critical_fields_map.png")
 
 
@@ -104,19 +148,30 @@ def dh_vs_s0(run, grid):
     if grid["threshold"] is not None:
         shades = shade_threshold_ranges(ax, grid, rows, run.radius())
     handles = []
+    hollow = unresolved(grid)
     for r, color in zip(rows, colors):
         dh = np.where(grid["hysteresis"][r], grid["dH"][r], 0.0)
-        (line,) = ax.plot(grid["s0"], dh, color=color, marker="o", markersize=2.5,
-                          linewidth=1.4)
-        handles.append((shades[r], line) if r in shades else line)
+        ax.plot(grid["s0"], dh, color=color, linewidth=1.4)
+        (line,) = ax.plot(grid["s0"][~hollow[r]], dh[~hollow[r]], color=color, marker="o",
+                          markersize=2.5, linestyle="none")
+        if np.any(hollow[r]):
+            ax.plot(grid["s0"][hollow[r]], dh[hollow[r]], color=color, marker="o",
+                    markersize=4, linestyle="none", markerfacecolor="w", zorder=3)
+        key = plt.Line2D([], [], color=color, marker="o", markersize=2.5, linewidth=1.4)
+        handles.append((shades[r], key) if r in shades else key)
     ax.set_xlabel(S0_LABEL)
-    ax.set_ylabel(r"$\Delta H = H_{C2} - H_{C1}$ (T)")
+    ax.set_ylabel(r"$\mu_0 \Delta H = \mu_0 (H_{C2} - H_{C1})$ (T)")
     ax.set_xlim(grid["s0"][0], grid["s0"][-1])
     ax.set_ylim(bottom=0.0)
     ax.grid(alpha=0.25)
-    ax.legend(handles, [row_name(grid, r) for r in rows], fontsize=8, loc="upper left",
-              title=legend_title(grid), title_fontsize=8)
-    run.suptitle(fig)
+    labels = [row_name(grid, r) for r in rows]
+    if np.any(hollow[rows]):
+        handles.append(plt.Line2D([], [], color="0.3", marker="o", markersize=4, linestyle="none",
+                                  markerfacecolor="w"))
+        labels.append(UNRESOLVED_LABEL)
+    ax.legend(handles, labels, fontsize=8, loc="upper left", title=legend_title(grid),
+              title_fontsize=8)
+    suptitle(run, fig)
     run.save(fig, "dH_vs_S0.png")
 
 

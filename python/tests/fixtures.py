@@ -171,3 +171,23 @@ def make_curve(directory, run_type):
     _write_csv(os.path.join(directory, "summary.csv"), ["step", "branch", "B_T", "M_over_Ms"],
                [[j, branch[j], field[j], m[j]] for j in range(field.size)])
     return directory
+
+
+DH_RESOLVED_COLUMN = "dH_resolved"  # as python/mresim_plots/pair_map.py reads it
+
+
+def add_dh_resolved(directory, threshold_t=0.02):
+    """A dH_resolved column in a pair_map summary.csv: 0 where 0 < dH < threshold_t (below the
+    critical-field tolerance), else 1. Returns the (row, col) pairs marked 0."""
+    path = os.path.join(directory, "summary.csv")
+    with open(path, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    unresolved = []
+    for r in rows:
+        dh, hyst = float(r["dH_T"]), int(float(r["hysteresis"]))
+        below = hyst > 0 and dh < threshold_t
+        r[DH_RESOLVED_COLUMN] = "0" if below else "1"
+        if below:
+            unresolved.append((int(r["row"]), int(r["col"])))
+    _write_csv(path, list(rows[0].keys()), [list(r.values()) for r in rows])
+    return unresolved

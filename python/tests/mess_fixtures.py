@@ -241,3 +241,94 @@ def make_stress(directory, positions=None):
     return write_run(directory, "mess_stress", along_z(fields[f_idx]), f_idx, l_idx, sigma, "Pa",
                      u, pair_centres(s), magnetizations(m_along), measured_strain=strain,
                      analysis=analysis, positions=positions)
+
+
+# ---------------------------------------------------------------- datasets of newer runs
+# Added to a run directory that a make_* function above wrote, as a newer mresim writes them
+# (docs/outputs-3d.md); the figures must draw them when present and skip them when absent.
+
+# Energies with known strain dependence for add_known_energies: per term (value at zero strain
+# per field index k, change per unit x^2). "wca", "dipole" and "load" are zero at every step;
+# "self" is constant in the strain (nonzero at the fields > 0).
+KNOWN_ENERGIES = {
+    "springs": (lambda k: 1e-15 * k, 2e-13),
+    "volume": (lambda k: 3e-16 * k, -5e-14),
+    "zeeman": (lambda k: -4e-13 * k, 1e-13 * 0.5),
+    "self": (lambda k: 2e-13 * k, 0.0),
+    "self_linearized": (lambda k: 3e-13 * k, 0.0),
+    "dipole": (lambda k: 0.0, 0.0),
+    "wca": (lambda k: 0.0, 0.0),
+    "load": (lambda k: 0.0, 0.0),
+}
+
+
+def add_known_energies(directory):
+    """Replaces /steps/energies/* of a strain or stress run by E = E0(k) + slope x^2 (x the
+    measured strain, k the field index) per KNOWN_ENERGIES; total the sum (less
+    self_linearized). Returns {term: E} as written."""
+    written = {}
+    with h5py.File(os.path.join(directory, "results.h5"), "a") as f:
+        s = f["steps"]
+        k = s["field_index"][()].astype(float)
+        x = s["measured_strain"][()]
+        for name, (e0, slope) in KNOWN_ENERGIES.items():
+            values = np.array([e0(v) for v in k]) + slope * x**2
+            s[f"energies/{name}"][...] = values
+            written[name] = values
+        written["total"] = sum(v for n, v in written.items() if n != "self_linearized")
+        s["energies/total"][...] = written["total"]
+    return written
+
+
+def add_pair_angle(directory, angles_deg=None):
+    """/steps/pair_angle (rad): by default 5 deg per unit of load index plus 2 deg per field
+    index, so that every field has its own curve."""
+    with h5py.File(os.path.join(directory, "results.h5"), "a") as f:
+        s = f["steps"]
+        if angles_deg is None:
+            angles_deg = 5.0 * s["load_index"][()] + 2.0 * s["field_index"][()]
+        s["pair_angle"] = np.radians(np.asarray(angles_deg, dtype=float))
+        s["pair_angle"].attrs["unit"] = "rad"
+    return np.asarray(angles_deg, dtype=float)
+
+
+def add_magnetostriction(directory, values=None):
+    """/steps/box_strain (S x 3) and /steps/magnetostriction (S, the z component: the fixtures'
+    field is along z); by default 2e-3 (B / 0.1 T)^2, the transverse components -half of it."""
+    with h5py.File(os.path.join(directory, "results.h5"), "a") as f:
+        s = f["steps"]
+        b = s["field_projection"][()]
+        along = 2e-3 * (b / 0.1) ** 2 if values is None else np.asarray(values, dtype=float)
+        s["box_strain"] = np.stack([-0.5 * along, -0.5 * along, along], axis=1)
+        s["magnetostriction"] = along
+        for name in ("box_strain", "magnetostriction"):
+            s[name].attrs["unit"] = "1"
+    return along
+
+
+def add_second_fit(directory, slope=None, form=None):
+    """/analysis/second_* of make_strain's run: the last field (index 3) drops by 8 J/m^3 from
+    its 8th strain on, so its second fit has the first fit's modulus, offset - 8, first point 7
+    and 4 points; the other fields have none (valid 0, NaN). slope: a /analysis/second_slope
+    value for field 3 (the u = a x^2/2 + b x + c form); form: a /analysis@second_form text."""
+    with h5py.File(os.path.join(directory, "results.h5"), "a") as f:
+        a = f["analysis"]
+        n = a["modulus"].shape[0]
+        last = n - 1
+        modulus, offset = np.full(n, np.nan), np.full(n, np.nan)
+        modulus[last] = a["modulus"][last]
+        offset[last] = a["offset"][last] - 8.0
+        first, points = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
+        first[last], points[last] = 7, 4
+        valid = np.zeros(n, dtype=np.int64)
+        valid[last] = 1
+        a["second_modulus"], a["second_offset"] = modulus, offset
+        a["second_rms_residual"] = np.where(valid > 0, 1e-3, np.nan)
+        a["second_first_point"], a["second_fit_points"], a["second_valid"] = first, points, valid
+        if slope is not None:
+            b = np.full(n, np.nan)
+            b[last] = slope
+            a["second_slope"] = b
+        if form is not None:
+            a.attrs["second_form"] = form
+    return dict(field=last, modulus=modulus[last], offset=offset[last], first=7, points=4)

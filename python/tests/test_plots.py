@@ -16,8 +16,10 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.image  # noqa: E402
+import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # python/
 import fixtures  # noqa: E402
 
 PYTHON_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -155,6 +157,126 @@ class ErrorTest(PlotTestCase):
     def test_usage(self):
         result = subprocess.run([sys.executable, SCRIPT], capture_output=True, text=True)
         self.assertEqual(result.returncode, 2)
+
+
+class KeptFiguresMixin:
+    """In-process drawing: a Run whose save() keeps the figures open for inspection."""
+
+    def kept_run(self, directory):
+        from mresim_plots import common
+
+        figures = {}
+
+        class Kept(common.Run):
+            def save(self, fig, name):
+                figures[name] = fig
+
+        run = Kept(directory)
+        run.figures = figures
+        return run
+
+    def tearDown(self):
+        import matplotlib.pyplot as plt
+        plt.close("all")
+        super().tearDown()
+
+
+def all_texts(fig):
+    """Every string drawn on a figure: titles, labels, legends, tick-free texts."""
+    texts = [t.get_text() for t in fig.texts]
+    if fig._suptitle is not None:
+        texts.append(fig._suptitle.get_text())
+    for ax in fig.axes:
+        texts += [ax.get_xlabel(), ax.get_ylabel()]
+        texts += [ax.get_title(loc=loc) for loc in ("left", "center", "right")]
+        texts += [t.get_text() for t in ax.texts]
+        if ax.get_legend() is not None:
+            texts += [t.get_text() for t in ax.get_legend().get_texts()]
+    for legend in fig.legends:
+        texts += [t.get_text() for t in legend.get_texts()]
+    return [t for t in texts if t]
+
+
+class PairFigureDetailsTest(KeptFiguresMixin, PlotTestCase):
+    def test_unresolved_dh_drawn_hollow_with_a_legend_entry(self):
+        from mresim_plots import pair_map
+        d = fixtures.make_pair_map(self.dir("k_res"), rows="k")
+        marked = fixtures.add_dh_resolved(d)
+        self.assertTrue(marked)
+        run = self.kept_run(d)
+        grid = pair_map.read_grid(run)
+        self.assertEqual(sorted(zip(*np.nonzero(pair_map.unresolved(grid)))), sorted(marked))
+        pair_map.dh_vs_s0(run, grid)
+        ax = run.figures["dH_vs_S0.png"].axes[0]
+        hollow = [ln for ln in ax.get_lines() if ln.get_markerfacecolor() == "w"]
+        rows = pair_map.selected_rows(grid["rows"].size)
+        expected = [r for r in rows if any(m[0] == r for m in marked)]
+        self.assertEqual(len(hollow), len(expected))
+        for ln, r in zip(hollow, expected):
+            cols = sorted(c for rr, c in marked if rr == r)
+            np.testing.assert_allclose(ln.get_xdata(), grid["s0"][cols])
+        # the filled markers of each row are its resolved points only
+        filled = [ln for ln in ax.get_lines() if ln.get_marker() == "o"
+                  and ln.get_markerfacecolor() != "w"]
+        self.assertEqual(len(filled), len(rows))
+        for ln, r in zip(filled, rows):
+            keep = [c for c in range(grid["s0"].size) if (r, c) not in marked]
+            np.testing.assert_allclose(ln.get_xdata(), grid["s0"][keep])
+        labels = [t.get_text() for t in ax.get_legend().get_texts()]
+        self.assertIn(pair_map.UNRESOLVED_LABEL, labels)
+
+    def test_without_the_flag_nothing_is_hollow(self):
+        from mresim_plots import pair_map
+        d = fixtures.make_pair_map(self.dir("k_nores"), rows="k")
+        run = self.kept_run(d)
+        grid = pair_map.read_grid(run)
+        self.assertIsNone(grid["resolved"])
+        pair_map.dh_vs_s0(run, grid)
+        pair_map.critical_fields_map(run, grid)
+        ax = run.figures["dH_vs_S0.png"].axes[0]
+        self.assertFalse([ln for ln in ax.get_lines() if ln.get_markerfacecolor() == "w"])
+        labels = [t.get_text() for t in ax.get_legend().get_texts()]
+        self.assertNotIn(pair_map.UNRESOLVED_LABEL, labels)
+        # the critical fields are mu0 H (T)
+        titles = [a.get_title() for a in run.figures["critical_fields_map.png"].axes[:3]]
+        self.assertTrue(all(r"\mu_0" in t for t in titles), titles)
+
+    def test_contact_line_behind_the_loop_and_typeset_labels(self):
+        from mresim_plots import loops, pair_hysteresis
+        cases = [dict(label=f"k = 0.04 N/m, S0 = {s0 * 1e6:g} um", model="single", s0=s0,
+                      hc1=0.2, hc2=0.8) for s0 in (6e-6, 9e-6)]
+        d = fixtures.make_pair_hysteresis(self.dir("contact"), cases)
+        run = self.kept_run(d)
+        summary = run.table("summary.csv")
+        pair_cases = pair_hysteresis.read_cases(run, summary)
+        pair_hysteresis.displacement(run, pair_cases)
+        fig = run.figures["displacement.png"]
+        for ax, case in zip(fig.axes, pair_cases):
+            contact_um = (2 * fixtures.RADIUS - case["s0"]) * 1e6
+            contact = [ln for ln in ax.get_lines() if len(ln.get_ydata()) == 2
+                       and np.allclose(ln.get_ydata(), contact_um)]
+            self.assertEqual(len(contact), 1, case["label"])
+            loop = [ln for ln in ax.get_lines() if len(ln.get_xdata()) > 2]
+            self.assertLess(contact[0].get_zorder(), min(ln.get_zorder() for ln in loop))
+            self.assertEqual(contact[0].get_linestyle(), loops.CONTACT_STYLE["linestyle"])
+        texts = all_texts(fig)
+        self.assertIn("k = 0.04 N/m, $S_0$ = 6 µm", texts)
+        self.assertIn(r"contact, $S = 2R$", texts)
+        self.assertFalse([t for t in texts if " um" in t or r"$\mu$m" in t], texts)
+
+
+class TypographyTest(unittest.TestCase):
+    def test_typeset(self):
+        from mresim_plots.typography import typeset
+        self.assertEqual(typeset("(a) k = 0.4 N/m, S0 = 6 um"), "(a) k = 0.4 N/m, $S_0$ = 6 µm")
+        self.assertEqual(typeset("three springs, theta_H = 10 deg"),
+                         r"three springs, $\theta_H$ = 10°")
+        self.assertEqual(typeset("mu0 H_C1 < B < mu0H_C2"),
+                         r"$\mu_0 H_{C1}$ < B < $\mu_0 H_{C2}$")
+        self.assertEqual(typeset("shear, Phi = 3 %, theta = 90"), "shear, Φ = 3 %, θ = 90")
+        # words that only contain the ASCII spellings stay; mathtext is left alone
+        self.assertEqual(typeset("column S0_m, drum, Phil"), "column S0_m, drum, Phil")
+        self.assertEqual(typeset(r"$x$ in um"), r"$x$ in um")
 
 
 def find_mresim():
