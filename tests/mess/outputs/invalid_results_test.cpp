@@ -255,6 +255,13 @@ TEST(MessOutputs, ModulusCsvHasPointsResidualAndValid) {
   EXPECT_EQ(h5.ints("/steps/valid"), (std::vector<std::int64_t>{1, 1, 1, 1}));
   EXPECT_EQ(h5.ints("/analysis/valid"), (std::vector<std::int64_t>{1}));
   EXPECT_EQ(h5.strings("/analysis/problem")[0], "");
+  // No kink on a polymer-dominated parabola: no second fit, NaN numbers, valid 0.
+  EXPECT_EQ(rows[1][column(header, "second_valid")], "0");
+  EXPECT_EQ(rows[1][column(header, "second_points")], "0");
+  EXPECT_TRUE(std::isnan(std::stod(rows[1][column(header, "second_modulus")])));
+  EXPECT_EQ(h5.ints("/analysis/second_valid"), (std::vector<std::int64_t>{0}));
+  EXPECT_TRUE(std::isnan(h5.doubles("/analysis/second_modulus")[0]));
+  EXPECT_EQ(h5.strings("/analysis/second_problem")[0], "no kink");
 }
 
 }  // namespace
