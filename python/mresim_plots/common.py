@@ -25,6 +25,9 @@ BRANCH_STYLE = {
 BRANCH_LINESTYLE = {0: ":", 1: "-", 2: "--"}
 FIELD_LABEL = r"$B = \mu_0 H$ (T)"
 MAG_LABEL = r"$M/M_s$"
+# Run.options: the view options of `mresim plot DIR` (mresim_plots/view_options.py parses
+# them); these defaults mean "none given".
+PLOT_OPTION_DEFAULTS = dict(step=[], plane=[], particle=None, field_map=[], animate=False)
 
 
 class PlotError(Exception):
@@ -41,8 +44,9 @@ def case_colors(n):
 class Run:
     """A finished run directory: results.h5 attributes, the input TOML, its CSV tables."""
 
-    def __init__(self, directory):
+    def __init__(self, directory, options=None):
         self.dir = directory
+        self.options = {**PLOT_OPTION_DEFAULTS, **(options or {})}
         self.h5_path = os.path.join(directory, "results.h5")
         if not os.path.isfile(self.h5_path):
             raise PlotError(f"'{directory}' has no results.h5")

@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 #include <string>
+#include <vector>
 
 #include "mresim/app/run_type.hpp"
 #include "mresim/config/table_reader.hpp"
@@ -45,9 +46,19 @@ struct InfoOptions {
 CLI::App* add_info_command(CLI::App& app, InfoOptions& options);
 int info_command(const InfoOptions& options);
 
+// `mresim plot DIR`: the view options are passed on to mresim_plot.py as given, which checks
+// them (python/mresim_plots/view_options.py; docs/cli.md).
 struct PlotOptions {
   std::string dir;
+  std::vector<std::string> steps;       // --step, repeatable
+  std::vector<std::string> planes;      // --plane, repeatable
+  std::string particle;                 // --particle, empty: not given
+  std::vector<std::string> field_maps;  // --field-map, repeatable
+  bool animate = false;
 };
+
+// The arguments after DIR for mresim_plot.py: "--step S" per value and so on.
+std::vector<std::string> plot_script_arguments(const PlotOptions& options);
 CLI::App* add_plot_command(CLI::App& app, PlotOptions& options);
 int plot_command(const PlotOptions& options);
 

@@ -119,7 +119,8 @@ std::string plotting_interpreter(int& failure_status) {
 
 }  // namespace
 
-int draw_figures(const std::filesystem::path& run_dir) {
+int draw_figures(const std::filesystem::path& run_dir,
+                 const std::vector<std::string>& script_args) {
   const auto script = python_dir() / "mresim_plot.py";
   if (!std::filesystem::is_regular_file(script)) {
     throw std::runtime_error(fmt::format(
@@ -130,7 +131,9 @@ int draw_figures(const std::filesystem::path& run_dir) {
   const std::string python = plotting_interpreter(failure_status);
   if (python.empty()) return failure_status;
   const auto started = std::filesystem::file_time_type::clock::now();
-  const ChildResult plot = spawn_and_wait({python, script.string(), run_dir.string()}, false);
+  std::vector<std::string> args = {python, script.string(), run_dir.string()};
+  args.insert(args.end(), script_args.begin(), script_args.end());
+  const ChildResult plot = spawn_and_wait(args, false);
   // The figures are mresim's files: list them in the run's manifest, so that a later run may
   // replace the directory. Only what this plot wrote, never a file the user put there.
   io::run_manifest::add_files_below(run_dir, "figures", started);

@@ -276,6 +276,38 @@ TEST(Cli, RunDrawsFiguresWithThePlotScript) {
   EXPECT_EQ(mresim(dir.path(), "plot demo", env).status, 7);
 }
 
+// `mresim plot DIR` passes the view options on to the script, one value per option as given
+// (mresim_plot.py checks them); DIR may come before or after them.
+TEST(Cli, PlotPassesTheViewOptionsToTheScript) {
+  if (!have_python3()) GTEST_SKIP() << "python3 not found";
+  const TempDir dir;
+  fs::create_directories(dir / "py");
+  write_text(dir / "py" / "mresim_plot.py",
+             "import sys\n"
+             "open(sys.argv[1] + '/args.txt', 'w').write('|'.join(sys.argv[2:]))\n");
+  write_text(dir / "demo.toml", kDummyRun);
+  ASSERT_EQ(testbed(dir.path(), "run demo.toml --no-plot").status, 0);
+  const std::string env = "MRESIM_PYTHON_DIR='" + (dir / "py").string() + "'";
+  const Result r = mresim(dir.path(),
+                          "plot demo --step 0,3 --plane y@1 --plane=z=mid --particle 1 "
+                          "--field-map eps_xz --step last --animate",
+                          env);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(read_text(dir / "demo" / "args.txt"),
+            "--step|0,3|--step|last|--plane|y@1|--plane|z=mid|--particle|1|--field-map|eps_xz|"
+            "--animate");
+  const Result before = mresim(dir.path(), "plot --step 2 --plane y=4.5e-6 demo", env);
+  ASSERT_EQ(before.status, 0) << before.err;
+  EXPECT_EQ(read_text(dir / "demo" / "args.txt"), "--step|2|--plane|y=4.5e-6");
+  const Result none = mresim(dir.path(), "plot demo", env);
+  ASSERT_EQ(none.status, 0) << none.err;
+  EXPECT_EQ(read_text(dir / "demo" / "args.txt"), "");
+  const Result help = mresim(dir.path(), "plot --help");
+  for (const char* word : {"--step", "--plane", "--particle", "--field-map", "--animate"}) {
+    EXPECT_NE(help.out.find(word), std::string::npos) << word;
+  }
+}
+
 // A 3D run with solver.method = "newton" starts MPI, whose singleton start forks a helper
 // process; started after results.h5 was open, the helper kept HDF5's lock on it and the plot
 // script could not read it. The fake script takes the shared lock h5py would.
