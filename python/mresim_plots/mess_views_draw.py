@@ -95,7 +95,8 @@ def particles_and_arrows(ax, views, step, plane, arrows=True, label=True, zorder
         m = d.magnetization[step] / d.ms
         length = m * 2.0 * r
         ax.quiver(c[:, h], c[:, v], length[:, h], length[:, v], angles="xy", scale_units="xy",
-                  scale=1.0, color=ARROW_COLOR, width=0.005, zorder=zorder + 2)
+                  scale=1.0, color=ARROW_COLOR, units="dots", width=2.6, headwidth=3.5,
+                  headlength=4.0, headaxislength=3.6, zorder=zorder + 2)
 
 
 def equal_limits(ax, hh, vv, pad_fraction=0.03):

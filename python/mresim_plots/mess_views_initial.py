@@ -47,19 +47,21 @@ def _view_direction():
 
 def outside_view(ax, grid):
     """Fig. 4.3a: the three faces of the box lattice that face the camera, as surfaces with
-    their lattice lines (every n-th line when there are more than MAX_LINES)."""
+    their lattice lines (every n-th line when there are more than MAX_LINES). Returns the
+    largest n."""
     toward = _view_direction()
     x = grid.x0 * 1e6
+    largest = 1
     for axis in range(3):
         side = grid.shape[axis] - 1 if toward[axis] > 0 else 0
         nodes = np.take(grid.node, side, axis=axis)
-        h, v = in_plane(axis)
         coords = [np.where(nodes >= 0, x[nodes, a], np.nan) for a in range(3)]
         stride = [max(1, int(np.ceil((n - 1) / MAX_LINES))) for n in nodes.shape]
+        largest = max(largest, *stride)
         ax.plot_surface(coords[0], coords[1], coords[2], rstride=stride[0], cstride=stride[1],
                         color="#d9c7a7", edgecolor="0.35", linewidth=0.3, shade=False,
                         alpha=1.0)
-        del h, v
+    return largest
 
 
 def particle_scatter_3d(ax, grid, shade=False):
@@ -154,10 +156,11 @@ def initial_configuration(run, views):
     c = fig.add_subplot(*shape, 3)
     d = fig.add_subplot(*shape, 4)
     left, right = (a, b), (c, d)
-    outside_view(left[0], grid)
+    stride = outside_view(left[0], grid)
     _setup_3d(left[0], grid)
     _panel_letter(left[0], "a")
-    left[0].set_title("outside view of the box", fontsize=8)
+    left[0].set_title("outside view of the box" + (f"\n(one lattice line in {stride} drawn)"
+                                                   if stride > 1 else ""), fontsize=8)
     particle_scatter_3d(left[1], grid)
     _setup_3d(left[1], grid)
     _panel_letter(left[1], "b")
