@@ -74,9 +74,8 @@ class DummyPlan final : public mresim::app::RunPlan {
   double step_seconds_ = 0.0;
 };
 
-const mresim::app::RunTypeRegistrar registrar({"test_dummy", "Test-only run type",
-                                               [](const mresim::config::TableReader& root) {
-                                                 return std::make_unique<DummyPlan>(root);
-                                               }});
+const mresim::app::RunTypeRegistrar dummy_run_type_registrar(
+    {"test_dummy", "Test-only run type",
+     [](const mresim::config::TableReader& root) { return std::make_unique<DummyPlan>(root); }});
 
 }  // namespace

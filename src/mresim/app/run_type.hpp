@@ -46,7 +46,9 @@ struct RunType {
 // Adds a run type; run types register themselves at program start from their own .cpp file:
 //
 //   namespace {
-//   const mresim::app::RunTypeRegistrar registrar({"pair_hysteresis", "Two-dipole hysteresis loop",
+//   // File-local names are unique across files (<file>_registrar): unity builds merge files.
+//   const mresim::app::RunTypeRegistrar hysteresis_run_registrar({
+//       "pair_hysteresis", "Two-dipole hysteresis loop",
 //       [](const mresim::config::TableReader& root) { return std::make_unique<MyPlan>(root); }});
 //   }
 //

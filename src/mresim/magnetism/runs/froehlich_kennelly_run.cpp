@@ -73,12 +73,13 @@ class FroehlichKennellyPlan final : public app::RunPlan {
   FieldSweep sweep_;
 };
 
-const app::RunTypeRegistrar registrar({"froehlich_kennelly",
-                                       "Froehlich-Kennelly magnetization curve of one particle, "
-                                       "eq. 1.5 (Fig. 1.6)",
-                                       [](const config::TableReader& root) {
-                                         return std::make_unique<FroehlichKennellyPlan>(root);
-                                       }});
+const app::RunTypeRegistrar froehlich_kennelly_run_registrar(
+    {"froehlich_kennelly",
+     "Froehlich-Kennelly magnetization curve of one particle, "
+     "eq. 1.5 (Fig. 1.6)",
+     [](const config::TableReader& root) {
+       return std::make_unique<FroehlichKennellyPlan>(root);
+     }});
 
 }  // namespace
 }  // namespace mresim::magnetism::runs

@@ -94,12 +94,11 @@ class PreisachPlan final : public app::RunPlan {
   FieldSweep sweep_;
 };
 
-const app::RunTypeRegistrar registrar({"preisach",
-                                       "Preisach hysteresis loop of a hard ferromagnet "
-                                       "(Fig. 1.5)",
-                                       [](const config::TableReader& root) {
-                                         return std::make_unique<PreisachPlan>(root);
-                                       }});
+const app::RunTypeRegistrar preisach_run_registrar(
+    {"preisach",
+     "Preisach hysteresis loop of a hard ferromagnet "
+     "(Fig. 1.5)",
+     [](const config::TableReader& root) { return std::make_unique<PreisachPlan>(root); }});
 
 }  // namespace
 }  // namespace mresim::magnetism::runs

@@ -18,14 +18,13 @@ class Hysteresis final : public Protocol {
   }
 };
 
-const ProtocolRegistrar registrar({"mess_hysteresis",
-                                   "3D lattice (MESS): field loop with all faces held (Chapter 4)",
-                                   {},
-                                   [](const config::TableReader& /*root*/) {
-                                     return std::make_shared<const Hysteresis>();
-                                   },
-                                   mess_config::FieldSequence::loop,
-                                   1});
+const ProtocolRegistrar hysteresis_protocol_registrar(
+    {"mess_hysteresis",
+     "3D lattice (MESS): field loop with all faces held (Chapter 4)",
+     {},
+     [](const config::TableReader& /*root*/) { return std::make_shared<const Hysteresis>(); },
+     mess_config::FieldSequence::loop,
+     1});
 
 }  // namespace
 }  // namespace mresim::mess_protocol

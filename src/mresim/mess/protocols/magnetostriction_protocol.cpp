@@ -18,14 +18,13 @@ class Magnetostriction final : public Protocol {
   }
 };
 
-const ProtocolRegistrar registrar({"mess_magnetostriction",
-                                   "3D lattice (MESS): field series with only the bottom face held",
-                                   {},
-                                   [](const config::TableReader& /*root*/) {
-                                     return std::make_shared<const Magnetostriction>();
-                                   },
-                                   mess_config::FieldSequence::up,
-                                   3});
+const ProtocolRegistrar magnetostriction_protocol_registrar(
+    {"mess_magnetostriction",
+     "3D lattice (MESS): field series with only the bottom face held",
+     {},
+     [](const config::TableReader& /*root*/) { return std::make_shared<const Magnetostriction>(); },
+     mess_config::FieldSequence::up,
+     3});
 
 }  // namespace
 }  // namespace mresim::mess_protocol

@@ -10,7 +10,8 @@
 // types do (app/run_type.hpp):
 //
 //   namespace {
-//   const ProtocolRegistrar registrar({"mess_magnetostriction", "3D lattice (MESS): ...", {},
+//   const ProtocolRegistrar magnetostriction_protocol_registrar({
+//       "mess_magnetostriction", "3D lattice (MESS): ...", {},
 //       [](const config::TableReader&) { return std::make_shared<const Magnetostriction>(); }});
 //   }
 //

@@ -131,7 +131,7 @@ class Strain final : public ProtocolWith<StrainSpec> {
   }
 };
 
-const ProtocolRegistrar registrar(
+const ProtocolRegistrar strain_protocol_registrar(
     {"mess_strain",
      "3D lattice (MESS): shear, tension, compression or torsion; G_eff / E_eff",
      {"strain"},

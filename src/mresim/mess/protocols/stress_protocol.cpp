@@ -137,7 +137,7 @@ class Stress final : public ProtocolWith<StressSpec> {
   }
 };
 
-const ProtocolRegistrar registrar(
+const ProtocolRegistrar stress_protocol_registrar(
     {"mess_stress",
      "3D lattice (MESS): applied shear, tension or compression stress",
      {"stress"},

@@ -22,7 +22,7 @@
 // Registration. Each term is one .cpp file that registers itself at program start:
 //
 //   namespace {
-//   const mresim::mess::EnergyTermRegistrar registrar({
+//   const mresim::mess::EnergyTermRegistrar wca_term_registrar({
 //       .name = "wca", .order = 70, .always_present = true,
 //       .make = [](const mresim::mess::TermContext&, const std::any&) {
 //         return std::make_unique<WcaTerm>(); }});

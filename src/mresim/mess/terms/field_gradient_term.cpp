@@ -132,11 +132,12 @@ std::unique_ptr<EnergyTerm> make_field_gradient(const TermContext& context, cons
                                              parameters.origin.value_or(centre));
 }
 
-const EnergyTermRegistrar registrar({.name = "field_gradient",
-                                     .order = 35,  // after the uniform Zeeman term (30)
-                                     .always_present = false,
-                                     .read = read_field_gradient,
-                                     .make = make_field_gradient});
+const EnergyTermRegistrar field_gradient_term_registrar(
+    {.name = "field_gradient",
+     .order = 35,  // after the uniform Zeeman term (30)
+     .always_present = false,
+     .read = read_field_gradient,
+     .make = make_field_gradient});
 
 }  // namespace
 }  // namespace mresim::mess

@@ -29,13 +29,13 @@ class LoadTerm final : public EnergyTerm {
                            TermGradient& /*out*/) const override {}
 };
 
-const EnergyTermRegistrar registrar({.name = "load",
-                                     .order = 80,
-                                     .always_present = true,
-                                     .read = {},
-                                     .make = [](const TermContext&, const std::any&) {
-                                       return std::make_unique<LoadTerm>();
-                                     }});
+const EnergyTermRegistrar load_term_registrar({.name = "load",
+                                               .order = 80,
+                                               .always_present = true,
+                                               .read = {},
+                                               .make = [](const TermContext&, const std::any&) {
+                                                 return std::make_unique<LoadTerm>();
+                                               }});
 
 }  // namespace
 }  // namespace mresim::mess

@@ -33,13 +33,14 @@ class SpringsTerm final : public EnergyTerm {
   SpringKernel kernel_;
 };
 
-const EnergyTermRegistrar registrar({.name = "springs",
-                                     .order = 10,
-                                     .always_present = true,
-                                     .read = {},
-                                     .make = [](const TermContext& c, const std::any&) {
-                                       return std::make_unique<SpringsTerm>(c.lattice);
-                                     }});
+const EnergyTermRegistrar springs_term_registrar({.name = "springs",
+                                                  .order = 10,
+                                                  .always_present = true,
+                                                  .read = {},
+                                                  .make = [](const TermContext& c,
+                                                             const std::any&) {
+                                                    return std::make_unique<SpringsTerm>(c.lattice);
+                                                  }});
 
 }  // namespace
 }  // namespace mresim::mess

@@ -38,13 +38,13 @@ class VolumeTerm final : public EnergyTerm {
   VolumeKernel kernel_;
 };
 
-const EnergyTermRegistrar registrar({.name = "volume",
-                                     .order = 20,
-                                     .always_present = true,
-                                     .read = {},
-                                     .make = [](const TermContext& c, const std::any&) {
-                                       return std::make_unique<VolumeTerm>(c.lattice);
-                                     }});
+const EnergyTermRegistrar volume_term_registrar({.name = "volume",
+                                                 .order = 20,
+                                                 .always_present = true,
+                                                 .read = {},
+                                                 .make = [](const TermContext& c, const std::any&) {
+                                                   return std::make_unique<VolumeTerm>(c.lattice);
+                                                 }});
 
 }  // namespace
 }  // namespace mresim::mess

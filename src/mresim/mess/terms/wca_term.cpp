@@ -42,13 +42,13 @@ class WcaTerm final : public EnergyTerm {
   }
 };
 
-const EnergyTermRegistrar registrar({.name = "wca",
-                                     .order = 70,
-                                     .always_present = true,
-                                     .read = {},
-                                     .make = [](const TermContext&, const std::any&) {
-                                       return std::make_unique<WcaTerm>();
-                                     }});
+const EnergyTermRegistrar wca_term_registrar({.name = "wca",
+                                              .order = 70,
+                                              .always_present = true,
+                                              .read = {},
+                                              .make = [](const TermContext&, const std::any&) {
+                                                return std::make_unique<WcaTerm>();
+                                              }});
 
 }  // namespace
 }  // namespace mresim::mess

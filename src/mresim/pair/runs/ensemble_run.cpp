@@ -147,12 +147,11 @@ class EnsemblePlan final : public app::RunPlan {
   std::vector<std::string> warnings_;  // read-time warnings, also in results.h5 /@warnings
 };
 
-const app::RunTypeRegistrar registrar({"pair_ensemble",
-                                       "Loops averaged over a weighted distribution of S0, loop "
-                                       "widening and susceptibility (Fig. 3.5)",
-                                       [](const config::TableReader& root) {
-                                         return std::make_unique<EnsemblePlan>(root);
-                                       }});
+const app::RunTypeRegistrar ensemble_run_registrar(
+    {"pair_ensemble",
+     "Loops averaged over a weighted distribution of S0, loop "
+     "widening and susceptibility (Fig. 3.5)",
+     [](const config::TableReader& root) { return std::make_unique<EnsemblePlan>(root); }});
 
 }  // namespace
 }  // namespace mresim::pair::runs

@@ -99,12 +99,11 @@ class HysteresisPlan final : public app::RunPlan {
   std::vector<std::string> warnings_;  // read-time warnings, also in results.h5 /@warnings
 };
 
-const app::RunTypeRegistrar registrar({"pair_hysteresis",
-                                       "Two-dipole hysteresis loops with critical fields "
-                                       "(Chapters 2-3)",
-                                       [](const config::TableReader& root) {
-                                         return std::make_unique<HysteresisPlan>(root);
-                                       }});
+const app::RunTypeRegistrar hysteresis_run_registrar(
+    {"pair_hysteresis",
+     "Two-dipole hysteresis loops with critical fields "
+     "(Chapters 2-3)",
+     [](const config::TableReader& root) { return std::make_unique<HysteresisPlan>(root); }});
 
 }  // namespace
 }  // namespace mresim::pair::runs

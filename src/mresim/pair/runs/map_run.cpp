@@ -174,12 +174,12 @@ class MapPlan final : public app::RunPlan {
   std::vector<std::string> warnings_;  // read-time warnings, also in results.h5 /@warnings
 };
 
-const app::RunTypeRegistrar registrar({"pair_map",
-                                       "Critical-field maps over (k, S0) or (theta_H, S0) "
-                                       "(Figs. 2.5, 2.9)",
-                                       [](const config::TableReader& root) {
-                                         return std::make_unique<MapPlan>(root);
-                                       }});
+const app::RunTypeRegistrar map_run_registrar({"pair_map",
+                                               "Critical-field maps over (k, S0) or (theta_H, S0) "
+                                               "(Figs. 2.5, 2.9)",
+                                               [](const config::TableReader& root) {
+                                                 return std::make_unique<MapPlan>(root);
+                                               }});
 
 }  // namespace
 }  // namespace mresim::pair::runs
