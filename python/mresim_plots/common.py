@@ -11,6 +11,8 @@ matplotlib.use("Agg")  # figures are files; never open a display
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from .typography import typeset  # noqa: E402
+
 DPI = 150
 DEFAULT_RADIUS_M = 1.5e-6
 TAUPE = "#b9a281"  # "no hysteresis" cells, as in Figs. 2.5 and 2.9
@@ -105,7 +107,7 @@ class Run:
 
     def suptitle(self, fig):
         if self.title:
-            fig.suptitle(self.title, fontsize=11)
+            fig.suptitle(typeset(self.title), fontsize=11)
 
 
 def require(table, columns, name):

@@ -6,9 +6,10 @@ Figures:
                                             magnetostriction) or against |B| at zero load
                                             (strain, stress); mess_energies.py
                  particle_magnetization.png centres and M at the last step (Fig. 4.22)
-                 lattice_cut.png            the deformed lattice in the y plane through the
-                                            first particle centre at the last step (Fig. 4.12);
-                                            only when node positions were written
+                 lattice_cut.png and the    the deformed lattice cut (Fig. 4.12), the initial
+                 other view figures         configuration (Figs. 4.2, 4.3, 4.24), magnetization
+                                            cuts (Figs. 4.22, 4.23) and strain maps; only when
+                                            node positions were written (mess_views.py)
   hysteresis,    separation_magnetization.png  smallest separation and M/Ms against B (Fig. 4.4)
   magnetostriction  magnetostriction.png    box strain along the field against B, when
                                             /steps/magnetostriction is not zero throughout
@@ -81,7 +82,7 @@ LOAD_RUN_TYPES = ("mess_strain", "mess_stress")
 
 def plot(run):
     # The figure modules import this one: imported here, not at the top.
-    from . import mess_energies, mess_magnetostriction, mess_pair_orientation
+    from . import mess_energies, mess_magnetostriction, mess_pair_orientation, mess_views
 
     data = MessData(run)
     mess_energies.energies(run, data)
@@ -98,7 +99,7 @@ def plot(run):
         separation_magnetization(run, data)
         mess_magnetostriction.magnetostriction(run, data)
     particle_magnetization(run, data)
-    lattice_cut(run, data)
+    mess_views.plot_views(run, data)  # lattice cuts, initial configuration, maps (with positions)
 
 
 class MessData:
@@ -619,57 +620,3 @@ def particle_magnetization(run, data):
     text += rf", mean $|M|/M_s$ = {mean_m:.3g}; arrows $2R\,M/M_s$"
     fig.suptitle((typeset(run.title) + "\n" if run.title else "") + text, fontsize=10)
     run.save(fig, "particle_magnetization.png")
-
-
-def lattice_cut(run, data):
-    """Fig. 4.12: the nodes of the y plane through the first particle centre at the last step,
-    deformed, joined along x and z, coloured by their displacement; particle nodes outlined.
-    Skipped when the run wrote no node positions."""
-    x0, x1 = data.initial_positions, data.last_positions
-    if x0 is None or x1 is None or x0.ndim != 2 or x0.shape != x1.shape:
-        return
-    le = data.element_length
-    if not math.isfinite(le) or le <= 0:
-        le = np.min(np.diff(np.unique(np.round(x0[:, 0], 15)))) if x0.shape[0] > 1 else 1.0
-    if data.initial_centres is not None and data.initial_centres.size >= 3:
-        y_centre = np.reshape(data.initial_centres, (-1, 3))[0, 1]
-    elif data.centres is not None and data.centres.ndim == 3 and data.centres.shape[1] > 0:
-        y_centre = data.centres[0, 0, 1]
-    else:
-        y_centre = 0.5 * (x0[:, 1].min() + x0[:, 1].max())
-    planes = np.unique(np.round(x0[:, 1] / le).astype(int))
-    plane = planes[np.argmin(np.abs(planes * le - y_centre))]
-    in_plane = np.flatnonzero(np.round(x0[:, 1] / le).astype(int) == plane)
-    ix = np.round(x0[in_plane, 0] / le).astype(int)
-    iz = np.round(x0[in_plane, 2] / le).astype(int)
-    ix -= ix.min()
-    iz -= iz.min()
-    gx = np.full((ix.max() + 1, iz.max() + 1), np.nan)
-    gz = np.full_like(gx, np.nan)
-    gx[ix, iz] = x1[in_plane, 0] * 1e6
-    gz[ix, iz] = x1[in_plane, 2] * 1e6
-    displacement = np.linalg.norm(x1[in_plane] - x0[in_plane], axis=1) * 1e6
-
-    fig, ax = plt.subplots(figsize=(6.4, 6.0), layout="constrained")
-    for row in range(gx.shape[0]):
-        ax.plot(gx[row, :], gz[row, :], color="0.55", linewidth=0.4, zorder=1)
-    for col in range(gx.shape[1]):
-        ax.plot(gx[:, col], gz[:, col], color="0.55", linewidth=0.4, zorder=1)
-    size = max(2.0, min(30.0, 6000.0 / in_plane.size))
-    points = ax.scatter(x1[in_plane, 0] * 1e6, x1[in_plane, 2] * 1e6, c=displacement, s=size,
-                        cmap="viridis", zorder=2)
-    fig.colorbar(points, ax=ax, label=r"displacement $|u|$ ($\mu$m)", shrink=0.8)
-    if data.particle_id is not None and data.particle_id.size == x0.shape[0]:
-        particle = in_plane[data.particle_id[in_plane] >= 0]
-        if particle.size:
-            ax.scatter(x1[particle, 0] * 1e6, x1[particle, 2] * 1e6, s=size * 1.6,
-                       facecolors="none", edgecolors="C3", linewidths=0.6, zorder=3,
-                       label="particle nodes")
-            ax.legend(fontsize=8, loc="upper right")
-    ax.set_aspect("equal")
-    ax.set_xlabel(r"$x$ ($\mu$m)")
-    ax.set_ylabel(r"$z$ ($\mu$m)")
-    ax.set_title(rf"cut at $y$ = {plane * le * 1e6:.3g} $\mu$m (through particle 0), last step",
-                 fontsize=9)
-    run.suptitle(fig)
-    run.save(fig, "lattice_cut.png")

@@ -14,6 +14,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # python/
 import mess_fixtures  # noqa: E402
 from test_plots import PlotTestCase  # noqa: E402
+from test_mess_views import default_figures  # noqa: E402
 
 COMMON = ["energies.png", "particle_magnetization.png"]
 FIELD_SWEEP = COMMON + ["separation_magnetization.png"]
@@ -30,15 +31,15 @@ class MessPlotTest(PlotTestCase):
 
     def test_hysteresis_with_position_files(self):
         d = mess_fixtures.make_hysteresis(self.dir("hyst_pos"), positions="files")
-        self.assert_figures(d, FIELD_SWEEP + ["lattice_cut.png"])
+        self.assert_figures(d, FIELD_SWEEP + default_figures(last_step=50))
 
     def test_magnetostriction_with_positions_in_results(self):
         d = mess_fixtures.make_magnetostriction(self.dir("ms"), positions="results")
-        self.assert_figures(d, FIELD_SWEEP + ["lattice_cut.png"])
+        self.assert_figures(d, FIELD_SWEEP + default_figures(last_step=10))
 
     def test_strain_with_kink_and_position_files(self):
         d = mess_fixtures.make_strain(self.dir("strain"), positions="files")
-        self.assert_figures(d, MODULUS + ["lattice_cut.png"],
+        self.assert_figures(d, MODULUS + default_figures(last_step=43),
                             absent=["separation_magnetization.png", "stress_strain.png"])
 
     def test_strain_without_reference_modulus(self):
