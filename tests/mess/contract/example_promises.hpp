@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -23,12 +24,14 @@ namespace mresim::testing::promises {
 
 // What a run wrote, per relaxation step and per modulus fit, in the units the data files use.
 struct RunData {
-  std::vector<double> field_mT;       // /steps/field_projection
-  std::vector<double> load;           // /steps/load_value (rad, strain or Pa)
-  std::vector<double> separation_um;  // /steps/separation (closest pair of centres)
-  std::vector<double> m_along_ms;     // /steps/magnetization_projection (units of Ms)
-  std::vector<double> wca_energy_j;   // /steps/energies/wca
-  std::filesystem::path results;      // for the energies of other terms (energy_J)
+  std::vector<double> field_mT;          // /steps/field_projection
+  std::vector<double> load;              // /steps/load_value (rad, strain or Pa)
+  std::vector<double> separation_um;     // /steps/separation (closest pair of centres)
+  std::vector<double> m_along_ms;        // /steps/magnetization_projection (units of Ms)
+  std::vector<double> wca_energy_j;      // /steps/energies/wca
+  std::vector<double> magnetostriction;  // /steps/magnetostriction (box strain along the field)
+  std::vector<double> pair_angle_deg;    // /steps/pair_angle, degrees
+  std::filesystem::path results;         // for the energies of other terms (energy_J)
   std::vector<std::int64_t> cluster_count, largest_cluster, converged, valid;
   std::vector<std::vector<std::int64_t>> cluster_id;  // [step][particle]
   std::vector<std::vector<double>> displacement_um;   // [step][3 * particle + axis], c - c_0
@@ -78,6 +81,8 @@ inline RunData read_run(const std::filesystem::path& results) {
   r.separation_um = scaled(h5.doubles("/steps/separation"), 1e6);
   r.m_along_ms = h5.doubles("/steps/magnetization_projection");
   r.wca_energy_j = h5.doubles("/steps/energies/wca");
+  r.magnetostriction = h5.doubles("/steps/magnetostriction");
+  r.pair_angle_deg = scaled(h5.doubles("/steps/pair_angle"), 180.0 / std::numbers::pi);
   r.cluster_count = h5.ints("/steps/cluster_count");
   r.largest_cluster = h5.ints("/steps/largest_cluster");
   r.converged = h5.ints("/steps/solver/converged");
@@ -158,6 +163,8 @@ inline double quantity(const RunData& r, const nlohmann::json& check, std::size_
   if (q == "separation_um") return r.separation_um[i];
   if (q == "M_along_Ms") return r.m_along_ms[i];
   if (q == "wca_energy_J") return r.wca_energy_j[i];
+  if (q == "magnetostriction") return r.magnetostriction[i];
+  if (q == "pair_angle_deg") return r.pair_angle_deg[i];
   if (q == "energy_J") {  // with "term": the dataset /steps/energies/<term>
     return Hdf5Reader(r.results)
         .doubles("/steps/energies/" + check.at("term").get<std::string>())

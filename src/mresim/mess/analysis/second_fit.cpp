@@ -13,10 +13,11 @@ namespace mresim::mess_analysis {
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kSecondFitNaN = std::numeric_limits<double>::quiet_NaN();
 
 SecondFit undetermined(std::size_t first, std::size_t points, std::string problem) {
-  return {kNaN, kNaN, kNaN, kNaN, first, points, false, std::move(problem)};
+  return {kSecondFitNaN, kSecondFitNaN, kSecondFitNaN, kSecondFitNaN,
+          first,         points,        false,         std::move(problem)};
 }
 
 std::size_t distinct_values(std::vector<double> x) {
@@ -28,7 +29,8 @@ std::size_t distinct_values(std::vector<double> x) {
 // (u = a t^2/2 + b' t + c', t = x - m), which keeps the three columns well apart for strains
 // far from zero (x = 0.03 ... 0.1: x^2/2, x and 1 are nearly collinear); then
 // b = b' - a m and c = c' - b' m + a m^2/2.
-void least_squares(const std::vector<double>& x, const std::vector<double>& u, SecondFit& fit) {
+void least_squares_with_slope(const std::vector<double>& x, const std::vector<double>& u,
+                              SecondFit& fit) {
   const auto n = static_cast<Eigen::Index>(x.size());
   double m = 0.0;
   for (const double xi : x) m += xi;
@@ -50,9 +52,9 @@ void least_squares(const std::vector<double>& x, const std::vector<double>& u, S
 }
 
 // The first rule of second_fit.hpp after the point count that the fit breaks, or "".
-std::string problem_of(const std::vector<double>& x, const std::vector<double>& u,
-                       const std::vector<bool>& converged, std::size_t first,
-                       const SecondFit& fit) {
+std::string second_fit_problem(const std::vector<double>& x, const std::vector<double>& u,
+                               const std::vector<bool>& converged, std::size_t first,
+                               const SecondFit& fit) {
   for (std::size_t i = 0; i < x.size(); ++i) {
     if (!std::isfinite(x[i]) || !std::isfinite(u[i])) {
       return fmt::format("non-finite point at strain {:.6g}", x[i]);
@@ -111,9 +113,10 @@ SecondFit fit_after_kink(const std::vector<double>& strain,
   if (finite && distinct_values(x) < 3) {
     return undetermined(first, points, "the strains after the kink take fewer than 3 values");
   }
-  SecondFit fit{kNaN, kNaN, kNaN, kNaN, first, points, false, {}};
-  if (finite) least_squares(x, u, fit);
-  fit.problem = problem_of(x, u, options.converged, first, fit);
+  SecondFit fit{kSecondFitNaN, kSecondFitNaN, kSecondFitNaN, kSecondFitNaN,
+                first,         points,        false,         {}};
+  if (finite) least_squares_with_slope(x, u, fit);
+  fit.problem = second_fit_problem(x, u, options.converged, first, fit);
   fit.valid = fit.problem.empty();
   return fit;
 }

@@ -18,7 +18,7 @@ namespace ma = mresim::mess_analysis;
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kNoFit = std::numeric_limits<double>::quiet_NaN();
 
 // The modulus of every field (Section 4.2.8) with what the outputs say about its fit.
 struct FieldFits {
@@ -38,7 +38,7 @@ struct FieldFits {
 
 ma::SecondFit no_second_fit(std::string problem) {
   ma::SecondFit s;
-  s.modulus = s.slope = s.offset = s.rms_residual = kNaN;
+  s.modulus = s.slope = s.offset = s.rms_residual = kNoFit;
   s.problem = std::move(problem);
   return s;
 }

@@ -15,7 +15,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr std::int64_t kFormatVersion = 1;
+// 2: the records have box_strain (a version-1 checkpoint cannot be resumed).
+constexpr std::int64_t kFormatVersion = 2;
 
 void write_optional(io::Hdf5File& file, const std::string& path, const Eigen::Matrix3Xd& m,
                     std::string_view unit) {

@@ -6,10 +6,11 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <numbers>
 
 #include "mresim/io/csv_writer.hpp"
-#include "mresim/mess/analysis/clusters.hpp"
 #include "mresim/mess/outputs/analysis_outputs.hpp"
+#include "mresim/mess/outputs/step_extras.hpp"
 #include "mresim/mess/outputs/step_records_io.hpp"
 #include "mresim/mess/protocols/protocol.hpp"
 #include "mresim/mess/protocols/step_plan.hpp"
@@ -18,7 +19,6 @@ namespace mresim::mess_protocol {
 
 namespace fs = std::filesystem;
 namespace mc = mresim::mess_config;
-namespace ma = mresim::mess_analysis;
 
 fs::path step_positions_file(const fs::path& run_dir, std::size_t step) {
   return run_dir / "positions" / fmt::format("step_{:06d}.h5", step);
@@ -74,45 +74,6 @@ void write_lattice(io::Hdf5File& results, const ProtocolRunner& runner) {
   results.write_int_vector("/lattice/particle_id", particle_id);
 }
 
-struct StepExtras {
-  std::vector<double> field_projection;
-  std::vector<double> magnetization_projection;
-  std::vector<double> energy_density;
-  std::vector<double> separation;
-  std::vector<std::int64_t> cluster_count;
-  std::vector<std::int64_t> largest_cluster;
-  std::vector<std::int64_t> cluster_id;  // steps x particles
-};
-
-StepExtras step_extras(const ProtocolRunner& runner, const std::vector<StepRecord>& records) {
-  const Eigen::Vector3d d = field_direction(runner.spec());
-  const double ms = runner.spec().particles.Ms;
-  const double contact = runner.system().model().wca.r_cut() > 0.0
-                             ? runner.system().model().wca.r_cut()
-                             : 2.0 * runner.system().lattice().particle_radius;
-  StepExtras x;
-  for (const StepRecord& r : records) {
-    x.field_projection.push_back(r.step.field.dot(d));
-    const auto np = r.magnetization.cols();
-    x.magnetization_projection.push_back(np > 0 ? (d.transpose() * r.magnetization).mean() / ms
-                                                : 0.0);
-    x.energy_density.push_back(r.energies.total() / r.system_volume);
-    if (!r.centres.allFinite()) {  // no distances: NaN separation, cluster data -1
-      x.separation.push_back(kNaN);
-      x.cluster_count.push_back(-1);
-      x.largest_cluster.push_back(-1);
-      x.cluster_id.insert(x.cluster_id.end(), static_cast<std::size_t>(np), -1);
-      continue;
-    }
-    x.separation.push_back(ma::min_separation(r.centres));
-    const ma::Clusters c = ma::find_clusters(r.centres, contact);
-    x.cluster_count.push_back(c.count);
-    x.largest_cluster.push_back(c.largest);
-    x.cluster_id.insert(x.cluster_id.end(), c.id.begin(), c.id.end());
-  }
-  return x;
-}
-
 void write_summary(const fs::path& run_dir, const std::vector<StepRecord>& records,
                    const StepExtras& x, const std::vector<std::int64_t>& valid,
                    const char* load_unit, const mess::TermLabels& terms) {
@@ -121,9 +82,9 @@ void write_summary(const fs::path& run_dir, const std::vector<StepRecord>& recor
       "By_T",           "Bz_T",        "B_along_T",  std::string("load_") + load_unit,
       "measured_strain"};
   for (const mess::TermLabel& t : terms) columns.push_back("E_" + t.name + "_J");
-  for (const char* c :
-       {"E_total_J", "energy_density_J_m3", "system_volume_m3", "M_along_Ms", "min_separation_m",
-        "clusters", "converged", "valid", "iterations", "max_force_N", "wall_time_s"}) {
+  for (const char* c : {"E_total_J", "energy_density_J_m3", "system_volume_m3", "M_along_Ms",
+                        "min_separation_m", "pair_angle_deg", "clusters", "magnetostriction",
+                        "converged", "valid", "iterations", "max_force_N", "wall_time_s"}) {
     columns.emplace_back(c);
   }
   io::CsvWriter csv(run_dir / "summary.csv", columns);
@@ -139,11 +100,12 @@ void write_summary(const fs::path& run_dir, const std::vector<StepRecord>& recor
                                r.step.load_value,
                                r.measured_strain};
     for (const mess::TermLabel& t : terms) row.push_back(energy_or_nan(r.energies, t.name));
-    row.insert(row.end(), {r.energies.total(), x.energy_density[i], r.system_volume,
-                           x.magnetization_projection[i], x.separation[i],
-                           static_cast<double>(x.cluster_count[i]), r.converged ? 1.0 : 0.0,
-                           static_cast<double>(valid[i]), static_cast<double>(r.iterations),
-                           r.max_force, r.wall_time});
+    row.insert(row.end(),
+               {r.energies.total(), x.energy_density[i], r.system_volume,
+                x.magnetization_projection[i], x.separation[i],
+                x.pair_angle[i] * 180.0 / std::numbers::pi, static_cast<double>(x.cluster_count[i]),
+                x.magnetostriction[i], r.converged ? 1.0 : 0.0, static_cast<double>(valid[i]),
+                static_cast<double>(r.iterations), r.max_force, r.wall_time});
     csv.row(row);
   }
 }
@@ -215,6 +177,7 @@ std::string non_finite_quantities(const StepRecord& r) {
   if (!energy) bad.emplace_back("energy");
   if (!std::isfinite(r.system_volume)) bad.emplace_back("system volume");
   if (!std::isfinite(r.measured_strain)) bad.emplace_back("measured strain");
+  if (!r.box_strain.allFinite()) bad.emplace_back("box strain");
   if (!r.centres.allFinite()) bad.emplace_back("particle centres");
   if (!r.magnetization.allFinite()) bad.emplace_back("magnetization");
   if (!std::isfinite(r.max_force)) bad.emplace_back("max force");
@@ -260,6 +223,7 @@ std::vector<StepRecord> with_nan_for_non_finite(std::vector<StepRecord> records)
     nan_if_not_finite(r.measured_strain);
     nan_if_not_finite(r.max_force);
     nan_if_not_finite(r.magnetization_residual);
+    for (double& e : r.box_strain) nan_if_not_finite(e);
     for (Eigen::Matrix3Xd* m : {&r.centres, &r.magnetization}) {
       *m = m->unaryExpr([](double v) { return std::isfinite(v) ? v : kNaN; });
     }
@@ -279,16 +243,23 @@ MessResultCheck write_mess_results(const fs::path& run_dir, io::Hdf5File& result
   const std::size_t np = runner.system().particle_count();
   write_step_records(results, "/steps", records, np, unit, *runner.system().energy_labels());
   results.write_int_vector("/steps/valid", valid);
-  const StepExtras x = step_extras(runner, records);
   const Eigen::Vector3d d = field_direction(spec);
+  const StepExtras x = step_extras(records, d, spec.analysis.cluster_distance, spec.particles.Ms);
   results.write_vector("/steps/field_direction", {d.x(), d.y(), d.z()}, "1");
   results.write_vector("/steps/field_projection", x.field_projection, "T");
   results.write_vector("/steps/magnetization_projection", x.magnetization_projection, "1");
   results.write_vector("/steps/energy_density", x.energy_density, "J/m^3");
   results.write_vector("/steps/separation", x.separation, "m");
+  results.write_vector("/steps/pair_angle", x.pair_angle, "rad");
+  results.write_string_attribute(
+      "/steps/pair_angle", "reference",
+      "the field direction /steps/field_direction: angle between it and the centre-to-centre "
+      "vector of the closest pair, in [0, pi/2]");
+  results.write_vector("/steps/magnetostriction", x.magnetostriction, "1");
   results.write_int_vector("/steps/cluster_count", x.cluster_count);
   results.write_int_vector("/steps/largest_cluster", x.largest_cluster);
   results.write_int_array("/steps/cluster_id", {records.size(), np}, x.cluster_id);
+  results.write_number_attribute("/steps", "cluster_distance", spec.analysis.cluster_distance);
   write_summary(run_dir, records, x, valid, unit, *runner.system().energy_labels());
   if (spec.protocol->analysis().kind != AnalysisKind::none) {
     write_analysis(run_dir, results, runner, records, x.energy_density, check);

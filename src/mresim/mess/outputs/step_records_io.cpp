@@ -89,6 +89,11 @@ void write_step_records(io::Hdf5File& file, const std::string& group,
                     "m^3");
   file.write_vector(g + "measured_strain",
                     column(records, [](auto& r) { return r.measured_strain; }), load_unit);
+  std::vector<double> box_strain;
+  for (const StepRecord& r : records) {
+    box_strain.insert(box_strain.end(), {r.box_strain.x(), r.box_strain.y(), r.box_strain.z()});
+  }
+  file.write_matrix(g + "box_strain", records.size(), 3, box_strain, "1");
   const std::vector<std::size_t> dims = {records.size(), particle_count, 3};
   file.write_array(g + "centres", dims, stacked(records, &StepRecord::centres), "m");
   file.write_array(g + "magnetization", dims, stacked(records, &StepRecord::magnetization), "A/m");
@@ -151,6 +156,9 @@ std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std:
   }
   const std::vector<double> volume = doubles(g + "system_volume");
   const std::vector<double> strain = doubles(g + "measured_strain");
+  const std::vector<double> box_strain = file.doubles(g + "box_strain");
+  if (box_strain.size() != 3 * n)
+    throw std::runtime_error("inconsistent length of " + g + "box_strain");
   const std::vector<double> centres = file.doubles(g + "centres");
   const std::vector<double> magnetization = file.doubles(g + "magnetization");
   const std::size_t per_step = 3 * particle_count;
@@ -177,6 +185,7 @@ std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std:
     StepRecord& r = records[i];
     r.system_volume = volume[i];
     r.measured_strain = strain[i];
+    r.box_strain = Eigen::Vector3d(box_strain[3 * i], box_strain[3 * i + 1], box_strain[3 * i + 2]);
     r.centres = Eigen::Map<const Eigen::Matrix3Xd>(centres.data() + i * per_step, 3, np);
     r.magnetization =
         Eigen::Map<const Eigen::Matrix3Xd>(magnetization.data() + i * per_step, 3, np);

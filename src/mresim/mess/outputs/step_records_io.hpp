@@ -18,7 +18,8 @@ namespace mresim::mess_protocol {
 // Writes /<group>/index, field, field_index, load_index, load_value, energies/<term> for every
 // term of `terms` (the system's list, MessSystem::energy_labels(); each dataset with string
 // attributes `equation` and `title`) and energies/total, system_volume, measured_strain,
-// centres, magnetization and solver/<diagnostic>. A record without a term's value gets NaN.
+// box_strain, centres, magnetization and solver/<diagnostic>. A record without a term's value
+// gets NaN.
 void write_step_records(io::Hdf5File& file, const std::string& group,
                         const std::vector<StepRecord>& records, std::size_t particle_count,
                         const char* load_unit, const mess::TermLabels& terms);

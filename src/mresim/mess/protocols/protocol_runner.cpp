@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "mresim/core/constants.hpp"
+#include "mresim/mess/analysis/box_strain.hpp"
 #include "mresim/mess/lattice/volume_elements.hpp"
 #include "mresim/mess/protocols/protocol.hpp"
 #include "mresim/mess/solvers/leapfrog.hpp"
@@ -139,6 +140,7 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   record.centres = system_.particle_centres();
   record.magnetization = system_.magnetizations();
   record.system_volume = system_volume(lat, system_.positions());
+  record.box_strain = mess_analysis::box_strain(lat, system_.positions());
   const Eigen::Matrix3Xd& zero_load =
       step.load_index > 0 ? state.references[step.field_index] : system_.positions();
   record.measured_strain = protocol.measured_strain(lat, step, system_.positions(), zero_load);

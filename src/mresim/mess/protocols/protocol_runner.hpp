@@ -35,12 +35,14 @@ namespace mresim::mess_protocol {
 struct StepRecord {
   StepSpec step;
   mess::MessEnergies energies;
-  double system_volume = 0.0;      // sum of the cell volumes, m^3
-                                   // (docs/original-code.md#energies-and-moduli)
-  double measured_strain = 0.0;    // strain runs: the applied strain (tan gamma for shear, the
-                                   // engineering strain, the twist angle); stress runs: measured
-  Eigen::Matrix3Xd centres;        // m, 3 x N_p
-  Eigen::Matrix3Xd magnetization;  // A/m, 3 x N_p
+  double system_volume = 0.0;    // sum of the cell volumes, m^3
+                                 // (docs/original-code.md#energies-and-moduli)
+  double measured_strain = 0.0;  // strain runs: the applied strain (tan gamma for shear, the
+                                 // engineering strain, the twist angle); stress runs: measured
+  Eigen::Vector3d box_strain = Eigen::Vector3d::Zero();  // along x, y, z from the face means
+                                                         // (analysis/box_strain.hpp)
+  Eigen::Matrix3Xd centres;                              // m, 3 x N_p
+  Eigen::Matrix3Xd magnetization;                        // A/m, 3 x N_p
 
   // Solver diagnostics.
   bool converged = false;        // relaxation converged and the final magnetization solve too

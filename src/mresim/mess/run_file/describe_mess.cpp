@@ -156,6 +156,10 @@ void describe_particles(const MessSpec& s, app::InfoReport& r) {
                                         *s.profile->wca_ms, s.profile->name)
                           : "mu0 pi Ms^2 R^3/72, eq. 4.79");
   r.add(sec, "wca_r_min", wca.r_min, "m", "2R + 100 nm");
+  r.add(sec, "cluster_distance", s.analysis.cluster_distance, "m",
+        s.analysis.cluster_distance_given
+            ? "[analysis] cluster_distance: centres this close are in contact"
+            : "the WCA cut-off 2^(1/6)(2R + 100 nm) (default): centres this close are in contact");
   if (!s.demagnetization) {
     r.add(sec, "zero_field_instability_distance", p.radius * std::cbrt(2.0 * p.chi0 / 3.0), "m",
           "pairs along the field closer than R (2 chi0/3)^(1/3) keep a remanent M at B = 0");

@@ -157,6 +157,16 @@ struct SolverSpec {
   magnetism::MagnetizationOptions magnetization;
 };
 
+// [analysis]: settings of what is derived from the relaxed states (docs/run-files-3d.md).
+struct AnalysisSpec {
+  // Two particles whose centres are at most this far apart (m) are in contact for the cluster
+  // analysis (/steps/cluster_count, largest_cluster, cluster_id). Resolved while reading: the
+  // run file's `cluster_distance`, else the WCA cut-off 2^(1/6)(2R + 100 nm) (eq. 4.79), the
+  // distance below which the particles repel.
+  double cluster_distance = 0.0;
+  bool cluster_distance_given = false;  // from the run file (else the default)
+};
+
 struct OutputSpec {
   bool node_positions = false;  // write all node positions per step (large)
   long checkpoint_every = 1;    // steps between checkpoints; 0 = none
@@ -234,6 +244,7 @@ struct MessSpec {
 
   FieldSpec field;
   SolverSpec solver;
+  AnalysisSpec analysis;
   OutputSpec output;
 
   MessGeometry geometry;

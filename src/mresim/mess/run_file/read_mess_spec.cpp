@@ -14,6 +14,7 @@
 #include "mresim/mess/lattice/stiffness.hpp"
 #include "mresim/mess/protocols/protocol.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
+#include "mresim/mess/run_file/read_analysis.hpp"
 
 namespace mresim::mess_config {
 
@@ -786,6 +787,7 @@ MessSpec read_mess_spec(const TableReader& root, std::string_view run_type) {
   if (const auto run = root.optional_table("run")) s.title = run->string_or("title", "");
   read_model(root.optional_table("model"), s);
   read_particles(root, s);
+  s.analysis = read_analysis(root.optional_table("analysis"), s.particles.radius);
   read_field(root, type.default_field_sequence, s.field);
   // The protocol's own table(s), e.g. [strain] (protocols/*_protocol.cpp).
   s.protocol = mess_protocol::read_protocol(root, run_type);
