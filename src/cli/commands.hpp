@@ -1,6 +1,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,7 @@ struct RunOptions {
   long threads = -1;  // -1: take [run].threads
   bool no_plot = false;
   bool force = false;  // move an unrecognised existing --out aside instead of refusing
+  std::vector<std::string> overrides;  // --set KEY=VALUE, repeatable, in order
 };
 CLI::App* add_run_command(CLI::App& app, RunOptions& options);
 int run_command(const RunOptions& options);
@@ -29,6 +31,18 @@ int run_command(const RunOptions& options);
 int execute_and_publish(const config::TableReader& root, const app::RunPlan& plan,
                         const std::string& run_type, io::RunDirectory& run_dir, long threads_option,
                         bool no_plot);
+
+// A run with --set overrides keeps them and the run file as written in this file of its staging
+// directory while it computes, so that `mresim resume` (whose checkpoint holds only the
+// effective run file) records them in results.h5 too; removed before the results are published.
+inline constexpr const char* kOverridesRecordFile = ".mresim-overrides.toml";
+void write_overrides_record(const config::TableReader& root, const std::filesystem::path& dir);
+// The run file of `effective_text` as it was made: the recorded file with the recorded overrides
+// applied, when `dir` holds a record whose result is exactly `effective_text`; else
+// `effective_text` as a plain run file (a run without overrides).
+config::TableReader read_with_overrides_record(const std::filesystem::path& dir,
+                                               const std::string& effective_text,
+                                               const std::string& name);
 
 // `mresim resume DIR`: continues an interrupted run from its last checkpoint.
 struct ResumeOptions {
@@ -42,6 +56,7 @@ int resume_command(const ResumeOptions& options);
 struct InfoOptions {
   std::string file;
   bool json = false;
+  std::vector<std::string> overrides;  // --set KEY=VALUE, as for run
 };
 CLI::App* add_info_command(CLI::App& app, InfoOptions& options);
 int info_command(const InfoOptions& options);
@@ -67,6 +82,10 @@ int types_command();
 
 // The --threads option of run and resume: an integer in [0, app::max_threads()].
 void add_threads_option(CLI::App& command, long& threads);
+
+// The --set KEY=VALUE option of run and info (config/overrides.hpp): repeatable, one argument
+// per occurrence, its form checked while the command line is parsed.
+void add_set_option(CLI::App& command, std::vector<std::string>& overrides);
 
 // "  name   summary" lines for every registered run type.
 std::string run_type_list();

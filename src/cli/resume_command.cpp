@@ -3,7 +3,13 @@
 // run file stored in the checkpoint and lets the run type continue from there. Only run types
 // that write checkpoints (the 3D runs, [output] checkpoint_every) can be resumed.
 
+#include <toml++/toml.h>
+
+#include <cstdio>
+#include <exception>
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include "cli/commands.hpp"
 #include "cli/exit_status.hpp"
@@ -29,6 +35,33 @@ CLI::App* add_resume_command(CLI::App& app, ResumeOptions& options) {
   return resume;
 }
 
+config::TableReader read_with_overrides_record(const fs::path& dir,
+                                               const std::string& effective_text,
+                                               const std::string& name) {
+  const fs::path file = dir / kOverridesRecordFile;
+  std::error_code ec;
+  if (fs::exists(file, ec)) {
+    try {
+      const toml::table record = toml::parse_file(file.string());
+      std::vector<std::string> overrides;
+      if (const auto* list = record["overrides"].as_array()) {
+        for (const auto& o : *list) overrides.push_back(o.value_or(std::string()));
+      }
+      const auto file_text = record["file_toml"].value<std::string>();
+      if (file_text && !overrides.empty()) {
+        auto root = config::TableReader::parse_string(*file_text, name, overrides);
+        if (root.source_text() == effective_text) return root;
+      }
+    } catch (const std::exception&) {  // unreadable: resume without it, say so below
+    }
+    std::fprintf(stderr,
+                 "mresim: warning: %s does not match the checkpoint; the results will record "
+                 "the effective run file only, without input_overrides and input_file_toml\n",
+                 file.string().c_str());
+  }
+  return config::TableReader::parse_string(effective_text, name);
+}
+
 int resume_command(const ResumeOptions& options) {
   const fs::path checkpoint_name = mess_protocol::kCheckpointFile;
   // Locks DIR first: while a run or another resume holds it, nothing is taken over.
@@ -40,7 +73,9 @@ int resume_command(const ResumeOptions& options) {
     text = checkpoint.string_attribute("/", "input_toml");
     name = checkpoint.string_attribute("/", "input_file");
   }
-  const auto root = config::TableReader::parse_string(text, name);
+  // A run with --set: the checkpoint holds the effective run file; the record beside it the file
+  // as written and the overrides, so that the resumed results.h5 records them as a run would.
+  const auto root = read_with_overrides_record(run_dir->path(), text, name);
   std::string run_type;
   const auto plan = app::make_plan(root, &run_type);
   std::printf("mresim: resuming the run in %s\n", run_dir->path().string().c_str());

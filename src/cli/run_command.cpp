@@ -2,9 +2,14 @@
 // and draw the figures.
 
 #include <fmt/format.h>
+#include <toml++/toml.h>
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "cli/commands.hpp"
 #include "cli/exit_status.hpp"
@@ -13,6 +18,7 @@
 #include "mresim/app/run_type.hpp"
 #include "mresim/app/stop_signal.hpp"
 #include "mresim/app/threads.hpp"
+#include "mresim/config/overrides.hpp"
 #include "mresim/config/table_reader.hpp"
 #include "mresim/io/hdf5_file.hpp"
 #include "mresim/io/metadata.hpp"
@@ -30,6 +36,7 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& options) {
                   "run there is replaced if it holds only the files mresim wrote; any other "
                   "existing directory is refused");
   add_threads_option(*run, options.threads);
+  add_set_option(*run, options.overrides);
   run->add_flag("--no-plot", options.no_plot, "Do not draw figures/*.png after the run");
   run->add_flag("--force", options.force,
                 "Use --out even if it holds files mresim did not write: the old directory is "
@@ -40,7 +47,8 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& options) {
 
 int run_command(const RunOptions& options) {
   // 1. Parse and validate the whole run file, unknown keys included, before touching the disk.
-  const auto root = config::TableReader::parse_file(options.file);
+  // --set overrides are applied to the parsed file first, so they are validated as the file is.
+  const auto root = config::TableReader::parse_file(options.file, options.overrides);
   std::string run_type;
   const auto plan = app::make_plan(root, &run_type);
 
@@ -91,6 +99,37 @@ void add_threads_option(CLI::App& command, long& threads) {
           "INT", "threads"));
 }
 
+void add_set_option(CLI::App& command, std::vector<std::string>& overrides) {
+  command
+      .add_option("--set", overrides,
+                  "Override one run-file value, KEY=VALUE: KEY a dotted key (field.max, "
+                  "case[1].penalty.type), VALUE a TOML value (0.05, \"x\", [1, 2], true; a bare "
+                  "word is a string). Repeatable; checked like the file (docs/cli.md)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->type_name("KEY=VALUE")
+      ->check(
+          CLI::Validator([](std::string& value) { return config::override_syntax_error(value); },
+                         "KEY=VALUE", "override"));
+}
+
+void write_overrides_record(const config::TableReader& root, const fs::path& dir) {
+  toml::array overrides;
+  for (const std::string& o : root.overrides()) overrides.push_back(o);
+  toml::table record;
+  record.insert_or_assign("file_toml", root.file_text());
+  record.insert_or_assign("overrides", std::move(overrides));
+  // Written whole, then renamed: a run killed meanwhile leaves no half record.
+  const fs::path file = dir / kOverridesRecordFile;
+  const fs::path temporary = fs::path(file.string() + ".tmp");
+  {
+    std::ofstream out(temporary, std::ios::binary);
+    out << config::toml_text(record);
+    if (!out.flush()) throw std::runtime_error("cannot write " + temporary.string());
+  }
+  fs::rename(temporary, file);
+}
+
 int execute_and_publish(const config::TableReader& root, const app::RunPlan& plan,
                         const std::string& run_type, io::RunDirectory& run_dir, long threads_option,
                         bool no_plot) {
@@ -103,6 +142,7 @@ int execute_and_publish(const config::TableReader& root, const app::RunPlan& pla
   // A run whose results are written but partly invalid (non-finite, unconverged) is still
   // published, with the bad entries marked, and ends with an error (exit status 4).
   std::string invalid_results;
+  if (!root.overrides().empty()) write_overrides_record(root, run_dir.path());
   {
     io::Hdf5File results(run_dir.path() / io::RunDirectory::kMarkerFile);
     io::write_run_metadata(results, root, run_type);
@@ -122,6 +162,8 @@ int execute_and_publish(const config::TableReader& root, const app::RunPlan& pla
     results.write_string_attribute("/", "invalid_results", invalid_results);
     results.close();
   }
+  std::error_code ec;
+  fs::remove(run_dir.path() / kOverridesRecordFile, ec);  // results.h5 holds it now
 
   // 4. Publish the complete directory in one step.
   run_dir.commit();

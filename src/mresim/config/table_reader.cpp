@@ -13,6 +13,8 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "mresim/config/overrides.hpp"
+
 namespace mresim::config {
 
 namespace detail {
@@ -20,7 +22,9 @@ namespace detail {
 // TableReader made from it so that reject_unknown_keys() sees all reads.
 struct Document {
   std::string source_name;
-  std::string text;
+  std::string text;       // what root was parsed from: the effective run file
+  std::string file_text;  // the file as written (differs from text only with overrides)
+  std::vector<std::string> overrides;
   toml::table root;
   std::map<std::string, std::set<std::string>, std::less<>> known;
 };
@@ -192,6 +196,11 @@ TableReader::TableReader(std::shared_ptr<detail::Document> doc, const void* tabl
     : doc_(std::move(doc)), table_(table), path_(std::move(path)) {}
 
 TableReader TableReader::parse_file(const std::filesystem::path& file) {
+  return parse_file(file, {});
+}
+
+TableReader TableReader::parse_file(const std::filesystem::path& file,
+                                    const std::vector<std::string>& overrides) {
   const std::string name = file.string();
   std::error_code ec;
   if (std::filesystem::is_directory(file, ec)) {
@@ -212,19 +221,37 @@ TableReader TableReader::parse_file(const std::filesystem::path& file) {
     throw ConfigError(
         fmt::format("cannot read run file '{}': {}", name, std::strerror(read_errno)));
   }
-  return parse_string(text, name);
+  return parse_string(text, name, overrides);
 }
 
 TableReader TableReader::parse_string(std::string_view text, std::string source_name) {
+  return parse_string(text, std::move(source_name), {});
+}
+
+TableReader TableReader::parse_string(std::string_view text, std::string source_name,
+                                      const std::vector<std::string>& overrides) {
   auto doc = std::make_shared<detail::Document>();
   doc->source_name = std::move(source_name);
   doc->text = std::string(text);
-  try {
-    doc->root = toml::parse(std::string_view(doc->text), std::string_view(doc->source_name));
-  } catch (const toml::parse_error& e) {
-    throw ConfigError(fmt::format("{}:{}:{}: TOML syntax error: {}", doc->source_name,
-                                  e.source().begin.line, e.source().begin.column,
-                                  one_line(e.description())));
+  const auto parse = [&doc] {
+    try {
+      doc->root = toml::parse(std::string_view(doc->text), std::string_view(doc->source_name));
+    } catch (const toml::parse_error& e) {
+      throw ConfigError(fmt::format("{}:{}:{}: TOML syntax error: {}", doc->source_name,
+                                    e.source().begin.line, e.source().begin.column,
+                                    one_line(e.description())));
+    }
+  };
+  parse();
+  if (!overrides.empty()) {
+    apply_overrides(doc->root, overrides);
+    doc->file_text = std::move(doc->text);
+    doc->overrides = overrides;
+    doc->text = toml_text(doc->root);
+    // Read the effective text back, so that the readers see exactly what is recorded.
+    parse();
+  } else {
+    doc->file_text = doc->text;
   }
   const void* root = &doc->root;
   return {std::move(doc), root, ""};
@@ -234,6 +261,8 @@ std::string TableReader::path(std::string_view key) const { return join_path(pat
 
 const std::string& TableReader::source_text() const { return doc_->text; }
 const std::string& TableReader::source_name() const { return doc_->source_name; }
+const std::string& TableReader::file_text() const { return doc_->file_text; }
+const std::vector<std::string>& TableReader::overrides() const { return doc_->overrides; }
 
 const void* TableReader::lookup(std::string_view key) const {
   auto it = doc_->known.find(path_);

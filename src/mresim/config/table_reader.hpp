@@ -42,6 +42,16 @@ class TableReader {
   // source_name stands in for the file name in messages ("<string>", "test.toml").
   static TableReader parse_string(std::string_view text, std::string source_name);
 
+  // The same with command-line overrides ("KEY=VALUE", `mresim run --set`, overrides.hpp)
+  // applied to the parsed table before anything reads it. With overrides, source_text() is the
+  // effective run file (the overridden table as toml++ writes it) and the readers read that text
+  // parsed again, so what is recorded is exactly what was validated and run; file_text() keeps
+  // the file as written. Without overrides this is parse_file/parse_string above.
+  static TableReader parse_file(const std::filesystem::path& file,
+                                const std::vector<std::string>& overrides);
+  static TableReader parse_string(std::string_view text, std::string source_name,
+                                  const std::vector<std::string>& overrides);
+
   // A finite number (TOML integer or float) inside `range`. `unit` (e.g. "N/m", "T", "" for
   // none) is shown in messages. Missing: "missing key 'model.k' (N/m)".
   [[nodiscard]] double number(std::string_view key, Range range, std::string_view unit) const;
@@ -140,9 +150,13 @@ class TableReader {
   // "unknown table [fiedl]; allowed: field, model, run".
   void reject_unknown_keys() const;
 
-  // The complete text of the run file and the name it was read under.
+  // The complete text of the run file and the name it was read under. With overrides, the
+  // effective run file (see parse_string); file_text() is then the file as written.
   [[nodiscard]] const std::string& source_text() const;
   [[nodiscard]] const std::string& source_name() const;
+  [[nodiscard]] const std::string& file_text() const;
+  // The "KEY=VALUE" overrides applied, in order; empty for a plain file.
+  [[nodiscard]] const std::vector<std::string>& overrides() const;
 
  private:
   TableReader(std::shared_ptr<detail::Document> doc, const void* table, std::string path);

@@ -21,6 +21,12 @@ void write_run_metadata(Hdf5File& file, const config::TableReader& root,
   file.write_string_attribute("/", "input_toml", root.source_text());
   file.write_string_attribute("/", "input_file", root.source_name());
   file.write_string_attribute("/", "created_utc", utc_timestamp());
+  if (!root.overrides().empty()) {
+    std::string lines;
+    for (const std::string& o : root.overrides()) lines += o + "\n";
+    file.write_string_attribute("/", "input_overrides", lines);
+    file.write_string_attribute("/", "input_file_toml", root.file_text());
+  }
 }
 
 }  // namespace mresim::io

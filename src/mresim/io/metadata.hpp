@@ -10,9 +10,13 @@ namespace mresim::io {
 // Records what is needed to reproduce a run as attributes of the root group of results.h5:
 //   mresim_version  program version (mresim::kVersion)
 //   run_type        [run].type
-//   input_toml      the complete run file, byte for byte
+//   input_toml      the complete run file, byte for byte; with --set overrides the effective
+//                   run file (the overridden table as toml++ writes it), which is what ran
 //   input_file      the name the run file was read under
 //   created_utc     ISO 8601 time stamp, e.g. 2025-01-31T14:05:09Z
+// and, only when there are --set overrides (so that a plain run's metadata is unchanged):
+//   input_overrides the KEY=VALUE arguments in the order applied, one per line
+//   input_file_toml the run file as written, byte for byte
 void write_run_metadata(Hdf5File& file, const config::TableReader& root,
                         const std::string& run_type);
 
