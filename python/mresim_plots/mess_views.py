@@ -128,7 +128,7 @@ class Views:
         count = self.data.b_along.size
         have = self.positions.steps
         if not specs:
-            return [have[-1]]
+            return [have[-1]] if have else []
         wanted = []
         for spec in specs:
             if spec[0] == "all":
@@ -176,8 +176,10 @@ class Views:
 
 
 def plot_views(run, data):
-    """Draws every view figure of the run into run.figures_dir (nothing without node
-    positions; view options given for such a run are an error)."""
+    """Draws every view figure of the run into run.figures_dir: the initial configuration
+    whenever results.h5 has the initial lattice (every run since it is always written), the
+    cuts, maps and animation only with node positions per step (view options for steps given
+    for a run without them are an error)."""
     views = make_views(run, data)
     if views is None:
         return
@@ -185,6 +187,8 @@ def plot_views(run, data):
     mess_views_initial.initial_configuration(run, views)
     mess_views_initial.particle_nodes_orthographic(run, views)
     mess_views_initial.particle_voxels(run, views)
+    if not views.positions.steps:
+        return
     for step in views.steps:
         for plane in views.planes:
             name = (views.file_name("lattice_cut", step, plane) if views.named
@@ -201,20 +205,22 @@ def plot_views(run, data):
 
 
 def make_views(run, data):
-    """Views of the run, or None when it has no node positions (an error if view options
-    were given: they could not be honoured)."""
+    """Views of the run, or None when it has no initial lattice. Options that need node
+    positions per step are an error for a run without them: they could not be honoured."""
     x0 = data.initial_positions
     positions = StepPositions(run) if x0 is not None else None
     if x0 is None or not positions.steps:
         given = [o for o, v in (("--step", run.options.get("step")),
                                 ("--plane", run.options.get("plane")),
-                                ("--particle", run.options.get("particle") is not None),
+                                ("--particle", x0 is None
+                                 and run.options.get("particle") is not None),
                                 ("--field-map", run.options.get("field_map")),
                                 ("--animate", run.options.get("animate"))) if v]
         if given:
             raise OptionError(f"{', '.join(given)}: '{run.dir}' has no node positions (run with "
                               "[output] node_positions = true)")
-        return None
+        if x0 is None or data.particle_id is None:
+            return None
     grid = LatticeGrid(x0, data.element_length, data.particle_id)
     return Views(run, data, grid, positions)
 

@@ -122,10 +122,10 @@ def write_run(directory, run_type, field, field_index, load_index, load_value, l
             a.attrs["modulus_name"] = analysis.pop("modulus_name")
             for key, value in analysis.items():
                 a[key] = value
-        if positions is not None:
+        if positions is not None:  # "initial": the initial lattice only, as every run writes
             lat["initial_positions"] = initial
             lat["particle_id"] = particle_id
-            for n in range(steps):
+            for n in range(steps if positions != "initial" else 0):
                 shear = float(load_value[n]) if load_unit == "rad" else 0.0
                 x = deformed(initial, n, shear)
                 if positions == "results":

@@ -14,7 +14,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # python/
 import mess_fixtures  # noqa: E402
 from test_plots import PlotTestCase  # noqa: E402
-from test_mess_views import default_figures  # noqa: E402
+from test_mess_views import INITIAL, default_figures  # noqa: E402
 
 COMMON = ["energies.png", "particle_magnetization.png"]
 FIELD_SWEEP = COMMON + ["separation_magnetization.png"]
@@ -59,6 +59,11 @@ class MessPlotTest(PlotTestCase):
             del f["analysis"]
         self.assert_figures(d, LOAD + ["energy_density_fit.png"],
                             absent=["modulus.png", "mr_effect.png"])
+
+    def test_initial_lattice_alone_gives_the_initial_views_but_no_cuts(self):
+        d = mess_fixtures.make_strain(self.dir("strain_initial"), positions="initial")
+        self.assert_figures(d, MODULUS + INITIAL,
+                            absent=["lattice_cut.png", "magnetization_cut_step0043.png"])
 
     def test_stress(self):
         d = mess_fixtures.make_stress(self.dir("stress"))

@@ -88,4 +88,28 @@ TEST(MessOutputs, ResultsSummaryAndXdmfAreConsistent) {
   EXPECT_NEAR(at(c[6], 2) - at(c[0], 2), le, 1e-15);
 }
 
+// Without node positions per step the initial lattice is still written (the initial-
+// configuration figures need it), but no cells, positions files or XDMF.
+TEST(MessOutputs, InitialLatticeIsWrittenWithoutNodePositions) {
+  const TempDir dir;
+  std::ofstream(dir / "run.toml") << mresim::mess_protocol::testing::small_hysteresis(0.1, 1);
+  const std::string command = "cd '" + dir.path().string() + "' && '" + MRESIM_CLI_PATH +
+                              "' run run.toml --out out --no-plot -j 2 >/dev/null 2>&1";
+  const int raw = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0);
+
+  const fs::path out = dir / "out";
+  const Hdf5Reader h5(out / "results.h5");
+  const auto particle_id = h5.ints("/lattice/particle_id");
+  const auto nodes = static_cast<hsize_t>(particle_id.size());
+  EXPECT_GT(nodes, 0U);
+  EXPECT_EQ(h5.shape("/lattice/initial_positions"), (std::vector<hsize_t>{nodes, 3}));
+  // Both particles have nodes, and most nodes are polymer (-1).
+  EXPECT_EQ(*std::max_element(particle_id.begin(), particle_id.end()), 1);
+  EXPECT_GT(std::count(particle_id.begin(), particle_id.end(), -1),
+            static_cast<std::ptrdiff_t>(nodes / 2));
+  EXPECT_FALSE(fs::exists(out / "mess.xdmf"));
+  EXPECT_FALSE(fs::exists(out / "positions"));
+}
+
 }  // namespace
