@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/config_error.hpp"
 #include "mresim/config/range.hpp"
 #include "mresim/config/table_reader.hpp"
 
@@ -36,18 +37,10 @@ toml::table overridden(const std::vector<std::string>& overrides) {
   return root;
 }
 
-std::string error_of(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected a ConfigError";
-  return {};
-}
+using mresim::testing::config_error_of;
 
 std::string apply_error(const std::string& argument) {
-  return error_of([&] { (void)overridden({argument}); });
+  return config_error_of([&] { (void)overridden({argument}); });
 }
 
 TEST(Overrides, ReplaceANumberAsTomlReadsIt) {
@@ -173,8 +166,9 @@ TEST(TableReaderOverrides, RecordTheFileTheOverridesAndTheEffectiveText) {
 
 TEST(TableReaderOverrides, OverriddenValuesAreValidatedLikeTheFile) {
   const auto root = TableReader::parse_string(kFile, "f.toml", {"field.max=-1"});
-  EXPECT_EQ(error_of([&] { (void)root.table("field").number("max", Range::positive(), "T"); }),
-            "field.max = -1: must be > 0 (T)");
+  EXPECT_EQ(
+      config_error_of([&] { (void)root.table("field").number("max", Range::positive(), "T"); }),
+      "field.max = -1: must be > 0 (T)");
   const auto typo = TableReader::parse_string(kFile, "f.toml", {"field.maxx=1"});
   const auto field = typo.table("field");
   (void)field.number("max", Range::positive(), "T");
@@ -182,7 +176,7 @@ TEST(TableReaderOverrides, OverriddenValuesAreValidatedLikeTheFile) {
   (void)typo.table("run").string_or("type", "");
   (void)typo.table_list("case");
   for (const auto& c : typo.table_list("case")) (void)c.string_or("label", "");
-  EXPECT_EQ(error_of([&] { typo.reject_unknown_keys(); }),
+  EXPECT_EQ(config_error_of([&] { typo.reject_unknown_keys(); }),
             "unknown key 'field.maxx' in [field]; allowed keys: max, step");
 }
 

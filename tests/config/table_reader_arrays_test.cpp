@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/config_error.hpp"
 #include "mresim/config/table_reader.hpp"
 
 namespace mresim::config {
@@ -14,16 +15,7 @@ namespace {
 
 TableReader parse(const std::string& text) { return TableReader::parse_string(text, "test.toml"); }
 
-// The message of the ConfigError `action` throws; fails the test if it throws nothing.
-std::string error_of(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected a ConfigError";
-  return {};
-}
+using mresim::testing::config_error_of;
 
 // The message of reject_unknown_keys() on `root`, or "" when every key was asked for.
 std::string unknown_of(const TableReader& root) {
@@ -52,19 +44,19 @@ TEST(TableReaderVector3, ReportsShapeTypeAndRange) {
   const auto read = [&](const char* key, std::string_view unit) {
     return [&box, key, unit] { (void)box.optional_vector3(key, Range::positive(), unit); };
   };
-  EXPECT_EQ(error_of(read("scalar", "m")), "box.scalar = 3: expected [x, y, z] (m)");
-  EXPECT_EQ(error_of(read("two", "m")), "box.two = [1, 2]: expected [x, y, z] (m)");
-  EXPECT_EQ(error_of(read("four", "")), "box.four = [1, 2, 3, 4]: expected [x, y, z]");
-  EXPECT_EQ(error_of(read("table", "m")), "box.table = {...}: expected [x, y, z] (m)");
-  EXPECT_EQ(error_of(read("words", "m")), "box.words[0] = \"9 um\": expected a number (m)");
-  EXPECT_EQ(error_of(read("nan", "m")), "box.nan[1] = nan: expected a finite number (m)");
-  EXPECT_EQ(error_of(read("negative", "m")), "box.negative[1] = -2: must be > 0 (m)");
+  EXPECT_EQ(config_error_of(read("scalar", "m")), "box.scalar = 3: expected [x, y, z] (m)");
+  EXPECT_EQ(config_error_of(read("two", "m")), "box.two = [1, 2]: expected [x, y, z] (m)");
+  EXPECT_EQ(config_error_of(read("four", "")), "box.four = [1, 2, 3, 4]: expected [x, y, z]");
+  EXPECT_EQ(config_error_of(read("table", "m")), "box.table = {...}: expected [x, y, z] (m)");
+  EXPECT_EQ(config_error_of(read("words", "m")), "box.words[0] = \"9 um\": expected a number (m)");
+  EXPECT_EQ(config_error_of(read("nan", "m")), "box.nan[1] = nan: expected a finite number (m)");
+  EXPECT_EQ(config_error_of(read("negative", "m")), "box.negative[1] = -2: must be > 0 (m)");
 }
 
 // The value in a message is written as elsewhere in the reader: strings escaped.
 TEST(TableReaderVector3, EscapesStringsInTheValue) {
   const auto box = parse("[box]\nsize = [\"a\\\"b\", 1]\n").table("box");
-  EXPECT_EQ(error_of([&] { (void)box.optional_vector3("size", Range::any(), "m"); }),
+  EXPECT_EQ(config_error_of([&] { (void)box.optional_vector3("size", Range::any(), "m"); }),
             R"(box.size = ["a\"b", 1]: expected [x, y, z] (m))");
 }
 
@@ -87,18 +79,18 @@ TEST(TableReaderVector3List, ReportsListSizeElementsAndComponents) {
       (void)field.optional_vector3_list(key, Range::non_negative(), "T", min_size);
     };
   };
-  EXPECT_EQ(error_of(read("scalar", 1)),
+  EXPECT_EQ(config_error_of(read("scalar", 1)),
             "field.scalar = 0.1: expected a list of [x, y, z] vectors (T)");
-  EXPECT_EQ(error_of(read("empty", 1)),
+  EXPECT_EQ(config_error_of(read("empty", 1)),
             "field.empty = []: expected at least 1 [x, y, z] vector (T)");
-  EXPECT_EQ(error_of(read("one", 2)),
+  EXPECT_EQ(config_error_of(read("one", 2)),
             "field.one = [[1, 2, 3]]: expected at least 2 [x, y, z] vectors (T)");
-  EXPECT_EQ(error_of(read("short", 1)), "field.short[1] = [0.1, 0]: expected [x, y, z] (T)");
-  EXPECT_EQ(error_of(read("flat", 1)), "field.flat[0] = 1: expected [x, y, z] (T)");
-  EXPECT_EQ(error_of(read("word", 1)), "field.word[1][1] = \"x\": expected a number (T)");
-  EXPECT_EQ(error_of(read("negative", 1)), "field.negative[0][2] = -3: must be >= 0 (T)");
+  EXPECT_EQ(config_error_of(read("short", 1)), "field.short[1] = [0.1, 0]: expected [x, y, z] (T)");
+  EXPECT_EQ(config_error_of(read("flat", 1)), "field.flat[0] = 1: expected [x, y, z] (T)");
+  EXPECT_EQ(config_error_of(read("word", 1)), "field.word[1][1] = \"x\": expected a number (T)");
+  EXPECT_EQ(config_error_of(read("negative", 1)), "field.negative[0][2] = -3: must be >= 0 (T)");
   const auto unitless = [&] { (void)field.optional_vector3_list("scalar", Range::any(), ""); };
-  EXPECT_EQ(error_of(unitless), "field.scalar = 0.1: expected a list of [x, y, z] vectors");
+  EXPECT_EQ(config_error_of(unitless), "field.scalar = 0.1: expected a list of [x, y, z] vectors");
 }
 
 TEST(TableReaderInteger3, ReadsThreeIntegers) {
@@ -116,11 +108,13 @@ TEST(TableReaderInteger3, ReportsShapeTypeAndRange) {
   const auto read = [&](const char* key) {
     return [&particles, key] { (void)particles.optional_integer3(key, Range::between(1, 10)); };
   };
-  EXPECT_EQ(error_of(read("scalar")), "particles.scalar = 2: expected three integers [x, y, z]");
-  EXPECT_EQ(error_of(read("two")), "particles.two = [1, 2]: expected three integers [x, y, z]");
-  EXPECT_EQ(error_of(read("word")), "particles.word[1] = \"1\": expected an integer");
-  EXPECT_EQ(error_of(read("whole")), "particles.whole[1] = 2.0: expected an integer");
-  EXPECT_EQ(error_of(read("zero")), "particles.zero[1] = 0: must be in [1, 10]");
+  EXPECT_EQ(config_error_of(read("scalar")),
+            "particles.scalar = 2: expected three integers [x, y, z]");
+  EXPECT_EQ(config_error_of(read("two")),
+            "particles.two = [1, 2]: expected three integers [x, y, z]");
+  EXPECT_EQ(config_error_of(read("word")), "particles.word[1] = \"1\": expected an integer");
+  EXPECT_EQ(config_error_of(read("whole")), "particles.whole[1] = 2.0: expected an integer");
+  EXPECT_EQ(config_error_of(read("zero")), "particles.zero[1] = 0: must be in [1, 10]");
 }
 
 TEST(TableReaderArrays, GettersMarkKeysKnownIsArrayDoesNot) {
@@ -169,16 +163,17 @@ TEST(TableReaderEnumeration, MessagesAreThoseOfChoice) {
       (void)t.enumeration<Sequence>(key, {{"loop", Sequence::loop}, {"up", Sequence::up}});
     };
   };
-  EXPECT_EQ(error_of(options(field, "sequence")),
+  EXPECT_EQ(config_error_of(options(field, "sequence")),
             "field.sequence = \"lop\": must be one of loop, up");
-  EXPECT_EQ(error_of(options(field, "number")),
+  EXPECT_EQ(config_error_of(options(field, "number")),
             "field.number = 1: expected a string, one of loop, up");
-  EXPECT_EQ(error_of(options(field, "absent")), "missing key 'field.absent' (one of loop, up)");
+  EXPECT_EQ(config_error_of(options(field, "absent")),
+            "missing key 'field.absent' (one of loop, up)");
   const auto other = parse("[field]\nsequense = \"up\"\n").table("field");
-  EXPECT_EQ(error_of(options(other, "sequence")),
+  EXPECT_EQ(config_error_of(options(other, "sequence")),
             "missing key 'field.sequence' (one of loop, up); the file has 'field.sequense' - a "
             "misspelling?");
-  EXPECT_EQ(error_of([&] {
+  EXPECT_EQ(config_error_of([&] {
               (void)field.enumeration_or("sequence", Sequence::up,
                                          {{"up", Sequence::up}, {"loop", Sequence::loop}});
             }),
