@@ -43,6 +43,21 @@ TEST(LatticePlacement, KindNamesAndAliases) {
   r.anisotropic = r.noisy = true;
   EXPECT_EQ(kind_of(r), PlacementKind::regular_anisotropic_noisy);
   EXPECT_EQ(to_string(kind_of(HelixPlacement{})), "helix");
+  // "none": a by-hand placement without positions, the particle-free block.
+  EXPECT_EQ(parse_placement_kind("none"), PlacementKind::none);
+  EXPECT_EQ(to_string(PlacementKind::none), "none");
+  EXPECT_EQ(kind_of(ByHandPlacement{}), PlacementKind::none);
+  ByHandPlacement one;
+  one.positions.emplace_back(1e-6, 1e-6, 1e-6);
+  EXPECT_EQ(kind_of(one), PlacementKind::by_hand);
+}
+
+TEST(LatticePlacement, NoParticlesGiveThePolymerBlock) {
+  ByHandPlacement none;
+  none.box.lengths = Eigen::Vector3d(6e-6, 5e-6, 4e-6);
+  const PlacedParticles p = place_particles(none, kR, 1);  // l_e = 1 um
+  EXPECT_TRUE(p.centre_cells.empty());
+  EXPECT_EQ(p.shape.nodes, (std::array<int, 3>{7, 6, 5}));
 }
 
 // Phi = 1 % and 5 %: the dissertation's separations (11.1818, 6.5454 um), centred in x and y.

@@ -115,7 +115,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"UnknownPlacement", with("placement = \"regular\"", "placement = \"random\""),
                  "particles.placement = \"random\": must be one of regular, regular_noisy, "
                  "regular_anisotropic, regular_anisotropic_noisy, anisotropic_regular, "
-                 "anisotropic_regular_noisy, by_hand, chain, helix"},
+                 "anisotropic_regular_noisy, by_hand, chain, helix, none"},
         BadInput{"UnknownKey", with("steps = 12", "steps = 12\nstpes = 13"),
                  "unknown key 'field.stpes' in [field]; allowed keys: magnitudes, max, phi, "
                  "sequence, steps, theta, values"},
@@ -195,7 +195,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"BoxWithRegularPlacement", kValid + "[box]\nsize = [1e-5, 1e-5, 1e-5]\n",
                  "box = {...}: placement = \"regular\" sizes the box from "
                  "particles.volume_fraction (eqs. 4.50-4.52); [box] is only read with placement "
-                 "= \"by_hand\", \"chain\" or \"helix\""},
+                 "= \"by_hand\", \"none\", \"chain\" or \"helix\""},
         BadInput{
             "KeyOfAnotherPlacement",
             with("count_per_axis = [1, 1, 2]", "count_per_axis = [1, 1, 2]\nseparation = 6e-6"),

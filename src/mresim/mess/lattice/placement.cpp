@@ -107,10 +107,11 @@ PlacementKind parse_placement_kind(std::string_view name) {
   if (name == "by_hand") return PlacementKind::by_hand;
   if (name == "chain") return PlacementKind::chain;
   if (name == "helix") return PlacementKind::helix;
+  if (name == "none") return PlacementKind::none;
   throw std::invalid_argument(fmt::format(
       "unknown particle placement '{}': allowed values are 'regular', 'regular_noisy', "
       "'regular_anisotropic' (or 'anisotropic_regular'), 'regular_anisotropic_noisy' (or "
-      "'anisotropic_regular_noisy'), 'by_hand', 'chain', 'helix'",
+      "'anisotropic_regular_noisy'), 'by_hand', 'chain', 'helix', 'none'",
       name));
 }
 
@@ -130,6 +131,8 @@ std::string to_string(PlacementKind kind) {
       return "chain";
     case PlacementKind::helix:
       return "helix";
+    case PlacementKind::none:
+      return "none";
   }
   return "";
 }
@@ -142,7 +145,9 @@ PlacementKind kind_of(const Placement& placement) {
     }
     return r->noisy ? PlacementKind::regular_noisy : PlacementKind::regular;
   }
-  if (std::holds_alternative<ByHandPlacement>(placement)) return PlacementKind::by_hand;
+  if (const auto* h = std::get_if<ByHandPlacement>(&placement)) {
+    return h->positions.empty() ? PlacementKind::none : PlacementKind::by_hand;
+  }
   if (std::holds_alternative<ChainPlacement>(placement)) return PlacementKind::chain;
   return PlacementKind::helix;
 }

@@ -91,9 +91,11 @@ enum class PlacementKind {
   regular_anisotropic_noisy,
   by_hand,
   chain,
-  helix
+  helix,
+  none  // no particles: the polymer block the MR effect is measured against (a ByHandPlacement
+        // without positions)
 };
-// Names as above ("by_hand", "chain", "helix"); "anisotropic_regular" and
+// Names as above ("by_hand", "chain", "helix", "none"); "anisotropic_regular" and
 // "anisotropic_regular_noisy" are accepted as aliases. Anything else throws
 // std::invalid_argument listing the allowed names.
 PlacementKind parse_placement_kind(std::string_view name);

@@ -132,7 +132,9 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   const mess::MagnetizationStats& after = system_.magnetization_stats();
   record.magnetization_solves = after.solves - before.solves;
   record.unconverged_magnetization_solves = after.unconverged - before.unconverged;
-  record.magnetization_method = mm::to_string(after.last.method);
+  // Without particles no magnetization is solved (MessSystem skips it): "none".
+  record.magnetization_method =
+      system_.particle_count() == 0 ? "none" : mm::to_string(after.last.method);
   record.magnetization_iterations = after.last.total_iterations;
   record.magnetization_residual = after.last.residual;
   record.converged = record.converged && (system_.particle_count() == 0 || after.last.converged);

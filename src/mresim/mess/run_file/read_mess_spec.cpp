@@ -34,7 +34,8 @@ const std::vector<std::string> kPlacements{"regular",
                                            "anisotropic_regular_noisy",
                                            "by_hand",
                                            "chain",
-                                           "helix"};
+                                           "helix",
+                                           "none"};
 
 // The table reader returns vectors as plain arrays (config/ does not depend on Eigen).
 Eigen::Vector3d to_vector(const std::array<double, 3>& v) { return {v[0], v[1], v[2]}; }
@@ -164,10 +165,11 @@ void read_placement(const TableReader& root, const TableReader& t, MessSpec& s) 
     reject_foreign_keys(t, name, used);
     if (root.has("box")) {
       root.fail("box", root.value_text("box"),
-                fmt::format("placement = \"{}\" sizes the box from particles.volume_fraction "
-                            "(eqs. 4.50-4.52); [box] is only read with placement = \"by_hand\", "
-                            "\"chain\" or \"helix\"",
-                            name));
+                fmt::format(
+                    "placement = \"{}\" sizes the box from particles.volume_fraction "
+                    "(eqs. 4.50-4.52); [box] is only read with placement = \"by_hand\", \"none\", "
+                    "\"chain\" or \"helix\"",
+                    name));
     }
     lattice::RegularPlacement r;
     r.volume_fraction = t.number("volume_fraction", Range::open(0.0, 1.0), "");
@@ -185,7 +187,15 @@ void read_placement(const TableReader& root, const TableReader& t, MessSpec& s) 
     return;
   }
 
-  if (kind == Kind::by_hand) {
+  if (kind == Kind::none) {
+    // The particle-free block (the polymer reference of the MR effect): radius and
+    // discretization_order still set l_e (eq. 4.49); the box is [box]'s.
+    reject_foreign_keys(t, name, {});
+    lattice::ByHandPlacement h;
+    h.box = read_box(root, *s.profile);
+    s.box = h.box;
+    s.lattice.placement = h;
+  } else if (kind == Kind::by_hand) {
     reject_foreign_keys(t, name, {"positions"});
     lattice::ByHandPlacement h;
     h.box = read_box(root, *s.profile);
@@ -301,6 +311,8 @@ void derive_checked(const TableReader& root, const TableReader& t, MessSpec& s) 
     const std::string message = without_placement_prefix(e.what());
     const bool overlap = message.find(" overlap") != std::string::npos;
     switch (kind) {
+      case Kind::none:
+        break;  // only the box can fail, which step 1 reports
       case Kind::by_hand: {
         const auto p = particle_named_in(message);
         const auto& positions = std::get<lattice::ByHandPlacement>(s.lattice.placement).positions;
