@@ -249,3 +249,57 @@ TEST(CriticalFields, NoHysteresisWhenTheFoldWouldLieInsideContact) {
 
 }  // namespace
 }  // namespace mresim::pair
+
+namespace mresim::pair {
+namespace {
+
+// Fig. 2.5 near the clustering threshold (S0 = 3.6 um, field along the axis, the example's
+// material: Ms = 1.4e6 A/m, chi = 2, tanh penalty): dH is 3e-6 to 9e-5 T there, below the 1e-4 T
+// critical-field tolerance. With brackets of the tolerance's width dH came out as 0 at some k
+// and as 0.01 T / 128 = 7.8e-5 T at others (the ragged S0 = 3.6 um column of Fig. 2.5). Now it
+// must be found at every k, grow smoothly with k, be resolved to 10 %, and agree with a sweep
+// 1000 times finer refined to 1e-7 T.
+PairSystem figure25_pair(double k) {
+  PairSystem p;
+  p.material.radius = 1.5e-6;
+  p.material.saturation_magnetization = 1.4e6;
+  p.material.susceptibility = 2.0;
+  p.springs = {SpringModel::single, k, 0.0, 3.6e-6};
+  p.penalty = OverlapPenalty::tanh_default(1.5e-6);
+  return p;
+}
+
+TEST(Figure25, DeltaHBelowTheToleranceIsFoundAndResolvedAtEveryK) {
+  double previous = 0.0;
+  for (const double k : {1e-3, 3.231e-3, 1.044e-2, 3.373e-2, 1.09e-1, 3.522e-1, 9e-1}) {
+    SCOPED_TRACE(k);
+    const CriticalFields f = critical_fields_of(figure25_pair(k), {});
+    ASSERT_TRUE(f.hysteresis);
+    ASSERT_TRUE(f.valid()) << f.problem;
+    EXPECT_LT(f.delta(), 1e-4);  // below the tolerance: the case the refinement must handle
+    EXPECT_TRUE(f.delta_resolved);
+    EXPECT_LE(f.delta_uncertainty, 0.01 * f.delta() + 1e-15);
+    EXPECT_GT(f.delta(), previous);  // dH grows with k along the column (no 0, no plateau)
+    previous = f.delta();
+  }
+}
+
+TEST(Figure25, SmallDeltaHAgreesWithAFineSweep) {
+  // k = 3.231e-3 N/m: dH = 5.4e-6 T, 1/18 of the tolerance.
+  const PairSystem p = figure25_pair(3.231e-3);
+  const CriticalFields coarse = critical_fields_of(p, {});
+  SweepOptions fine;
+  fine.b_max = 0.03;
+  fine.b_step = 1e-5;
+  CriticalFieldOptions fine_options;
+  fine_options.tolerance = 1e-7;
+  const CriticalFields reference = critical_fields_of(p, fine, fine_options);
+  ASSERT_TRUE(coarse.hysteresis);
+  ASSERT_TRUE(reference.hysteresis);
+  EXPECT_NEAR(coarse.delta(), reference.delta(), 0.02 * reference.delta());
+  EXPECT_NEAR(coarse.hc2, reference.hc2, 1e-7);
+  EXPECT_NEAR(coarse.hc1, reference.hc1, 1e-7);
+}
+
+}  // namespace
+}  // namespace mresim::pair

@@ -49,13 +49,18 @@ struct Refined {
   double half_width = 0.0;
 };
 
-// Bisects between a bistable field and a single-state field; returns the midpoint. Stops at
-// the tolerance, or when the midpoint is no longer strictly between the ends (double
-// precision), and never after more halvings than the tolerance needs.
-Refined refine(const PairSystem& system, Bracket b, const Eigen::Vector3d& direction,
+// Rounds of narrowing both brackets to the scale of dH: each round re-estimates dH; two
+// suffice unless dH shrinks a lot as the brackets narrow, and the rounds end earlier when a
+// round gains nothing.
+constexpr int kMaxDeltaRounds = 8;
+
+// Bisects between a bistable field and a single-state field (narrowing `b` in place); returns
+// the midpoint. Stops at bracket width `width`, or when the midpoint is no longer strictly
+// between the ends (double precision), and never after more halvings than `width` needs.
+Refined refine(const PairSystem& system, Bracket& b, double width, const Eigen::Vector3d& direction,
                const SweepOptions& sweep, const CriticalFieldOptions& opt, Audit& audit) {
-  const int limit = bisection_limit(std::abs(b.single_field - b.bistable_field), opt.tolerance);
-  for (int i = 0; i < limit && std::abs(b.single_field - b.bistable_field) > opt.tolerance; ++i) {
+  const int limit = bisection_limit(std::abs(b.single_field - b.bistable_field), width);
+  for (int i = 0; i < limit && std::abs(b.single_field - b.bistable_field) > width; ++i) {
     const double mid = 0.5 * (b.single_field + b.bistable_field);
     if (mid == b.single_field || mid == b.bistable_field) break;
     const PairState a =
@@ -76,18 +81,39 @@ Refined refine(const PairSystem& system, Bracket b, const Eigen::Vector3d& direc
           0.5 * std::abs(b.single_field - b.bistable_field)};
 }
 
+// Which half of a sweep step the jump lies in, when a trial field holds a single state: that
+// state is on the upper end's (clustered) branch, so the jump lies below the trial field, ...
+enum class SingleStateRule {
+  // ... when it is the upper end's state itself (they do not differ, differ() above). Right
+  // near the clustering threshold, where the separated branch runs steeply down to a fold just
+  // above contact and the nearer-end rule below mistakes it for the clustered state; wrong
+  // where the clustered state itself moves with the field by more than the differ() threshold
+  // within the step (a soft WCA wall).
+  same_as_upper_end,
+  // ... when it lies nearer to the upper end's state than to the lower end's.
+  nearer_end,
+};
+
 // A bistable range narrower than the sweep step can fall between two grid fields: the rising
 // branch then jumps between b_lo and b_hi with no grid field holding two states. Bisect the
 // step: at a trial field relax from both ends' states; if they differ the field is bistable
-// (returned as a bracket for both ends), otherwise the single state tells which half the jump
-// lies in. Returns nothing if the step holds only a steep but continuous change.
+// (returned as a bracket for both ends), otherwise the single state tells (by `rule`) which
+// half the jump lies in. Returns nothing if the step holds only a steep but continuous change
+// (or `rule` lost the jump).
 std::optional<std::pair<Bracket, Bracket>> bistable_inside_step(
     const PairSystem& system, PairState before, PairState after, const Eigen::Vector3d& direction,
-    const SweepOptions& sweep, const CriticalFieldOptions& opt, Audit& audit) {
+    const SweepOptions& sweep, const CriticalFieldOptions& opt, SingleStateRule rule,
+    Audit& audit) {
   double b_lo = before.field;
   double b_hi = after.field;
-  const int limit = bisection_limit(b_hi - b_lo, opt.tolerance);
-  for (int i = 0; i < limit && b_hi - b_lo > opt.tolerance; ++i) {
+  // Down to the finest bracket, not just the tolerance: a range narrower than the tolerance
+  // (dH ~ 1e-5 T near the clustering threshold) is found once the bracket is below twice its
+  // width. A continuous (steep but single-valued) change stops the search instead: its ends
+  // stop being distinct states as the bracket shrinks.
+  const double finest = opt.tolerance * opt.finest_fraction;
+  const int limit = bisection_limit(b_hi - b_lo, finest);
+  for (int i = 0; i < limit && b_hi - b_lo > finest; ++i) {
+    if (!differ(before, after, opt, system.material.radius)) break;
     const double mid = 0.5 * (b_lo + b_hi);
     if (mid == b_lo || mid == b_hi) break;
     const PairState a = relax_at_field(system, mid, direction, before.separation, sweep.relax);
@@ -97,12 +123,16 @@ std::optional<std::pair<Bracket, Bracket>> bistable_inside_step(
     if (differ(a, c, opt, system.material.radius)) {
       return std::pair{Bracket{mid, a, c, b_hi}, Bracket{mid, a, c, b_lo}};
     }
-    if ((a.separation - before.separation).norm() < (a.separation - after.separation).norm()) {
-      b_lo = mid;
-      before = a;
-    } else {
+    const bool upper_branch =
+        rule == SingleStateRule::same_as_upper_end
+            ? !differ(a, after, opt, system.material.radius)
+            : (a.separation - after.separation).norm() <= (a.separation - before.separation).norm();
+    if (upper_branch) {
       b_hi = mid;
       after = a;
+    } else {
+      b_lo = mid;
+      before = a;
     }
   }
   return std::nullopt;
@@ -113,13 +143,41 @@ void refine_both(const PairSystem& system, const Bracket& hc2, const std::option
                  const Eigen::Vector3d& direction, const SweepOptions& sweep,
                  const CriticalFieldOptions& options, Audit& audit, CriticalFields& result) {
   result.hysteresis = true;
-  const Refined up = refine(system, hc2, direction, sweep, options, audit);
+  Bracket upper = hc2;
+  Refined up = refine(system, upper, options.tolerance, direction, sweep, options, audit);
   result.hc2 = up.field;
   result.uncertainty = up.half_width;
   if (hc1) {
-    const Refined down = refine(system, *hc1, direction, sweep, options, audit);
+    Bracket lower = *hc1;
+    Refined down = refine(system, lower, options.tolerance, direction, sweep, options, audit);
+    // The scale of dH sets the final brackets (CriticalFieldOptions::delta_relative): narrow
+    // both until their half-widths add up to delta_relative x dH, re-estimating dH each round.
+    const double finest = options.tolerance * options.finest_fraction;
+    // This is precision beyond the tolerance: a relaxation that fails to converge in it (the
+    // softest springs slow down at their folds) ends it and keeps the brackets reached so far,
+    // rather than invalidating critical fields that were found to the tolerance.
+    for (int round = 0; round < kMaxDeltaRounds; ++round) {
+      const double delta = up.field - down.field;
+      if (up.half_width + down.half_width <= options.delta_relative * delta) break;
+      const double width = std::max(finest, options.delta_relative * delta);
+      Audit extra;
+      Bracket upper_next = upper;
+      Bracket lower_next = lower;
+      const Refined u = refine(system, upper_next, width, direction, sweep, options, extra);
+      const Refined d = refine(system, lower_next, width, direction, sweep, options, extra);
+      if (!extra.converged) break;
+      const bool progress = u.half_width < up.half_width || d.half_width < down.half_width;
+      upper = upper_next;
+      lower = lower_next;
+      up = u;
+      down = d;
+      if (!progress) break;  // at the finest bracket or at double precision
+    }
+    result.hc2 = up.field;
     result.hc1 = down.field;
-    result.uncertainty = std::max(result.uncertainty, down.half_width);
+    result.uncertainty = std::max(up.half_width, down.half_width);
+    result.delta_uncertainty = up.half_width + down.half_width;
+    result.delta_resolved = result.delta_uncertainty <= kResolvedFraction * result.delta();
   } else {  // still bistable at zero field: no H_C1 in the swept range
     result.hc1 = 0.0;
     result.in_range = false;
@@ -171,7 +229,12 @@ CriticalFields find_critical_fields(const PairSystem& system, const HysteresisLo
       const PairState& lo = *it->second;
       const PairState& hi = *std::next(it)->second;
       if ((hi.separation - lo.separation).norm() <= jump) continue;
-      const auto found = bistable_inside_step(system, lo, hi, direction, sweep, options, audit);
+      auto found = bistable_inside_step(system, lo, hi, direction, sweep, options,
+                                        SingleStateRule::same_as_upper_end, audit);
+      if (!found) {
+        found = bistable_inside_step(system, lo, hi, direction, sweep, options,
+                                     SingleStateRule::nearer_end, audit);
+      }
       if (!found) continue;
       refine_both(system, found->first, found->second, direction, sweep, options, audit, result);
       return result;

@@ -97,10 +97,12 @@ class MapPlan final : public app::RunPlan {
     const std::size_t cols = separations_.size();
     io::CsvWriter csv(dir / "summary.csv",
                       {"row", "col", "row_value", "S0_m", "hysteresis", "HC1_T", "HC2_T", "dH_T",
-                       "k12_N_per_m", "k0_N_per_m", "valid"});
+                       "dH_uncertainty_T", "dH_resolved", "k12_N_per_m", "k0_N_per_m", "valid"});
     std::vector<double> hc1;
     std::vector<double> hc2;
     std::vector<double> dh;
+    std::vector<double> dh_uncertainty;  // T, the error bound of each dH
+    std::vector<double> dh_resolved;     // 1 where dH is known to 10 % (kResolvedFraction)
     std::vector<std::int64_t> hysteresis;
     std::vector<double> valid;
     app::ResultCheck check("non-finite results");
@@ -115,11 +117,13 @@ class MapPlan final : public app::RunPlan {
         check_critical_fields(check, where, f);
         check_critical_fields_valid(unmarked, where, f);
         csv.row({static_cast<double>(r), static_cast<double>(c), rows_[r], separations_[c],
-                 f.hysteresis ? 1.0 : 0.0, f.hc1, f.hc2, f.delta(), p.springs.k12, p.springs.k0,
-                 ok ? 1.0 : 0.0});
+                 f.hysteresis ? 1.0 : 0.0, f.hc1, f.hc2, f.delta(), f.delta_uncertainty,
+                 f.delta_resolved ? 1.0 : 0.0, p.springs.k12, p.springs.k0, ok ? 1.0 : 0.0});
         hc1.push_back(f.hc1);
         hc2.push_back(f.hc2);
         dh.push_back(f.delta());
+        dh_uncertainty.push_back(f.delta_uncertainty);
+        dh_resolved.push_back(f.delta_resolved ? 1.0 : 0.0);
         hysteresis.push_back(f.hysteresis ? 1 : 0);
         valid.push_back(ok ? 1.0 : 0.0);
       }
@@ -134,6 +138,8 @@ class MapPlan final : public app::RunPlan {
     h5.write_matrix("/map/HC1", rows, cols, hc1, "T");
     h5.write_matrix("/map/HC2", rows, cols, hc2, "T");
     h5.write_matrix("/map/dH", rows, cols, dh, "T");
+    h5.write_matrix("/map/dH_uncertainty", rows, cols, dh_uncertainty, "T");
+    h5.write_array("/map/dH_resolved", {rows, cols}, dh_resolved, "1");
     std::vector<double> as_double(hysteresis.begin(), hysteresis.end());
     h5.write_array("/map/hysteresis", {rows, cols}, as_double, "1");
     if (row_parameter_ == "k") {
