@@ -139,6 +139,8 @@ class MessData:
                     self.energy_order = _text(s["energies"].attrs["terms"]).split(",")
             self.energy_density = _array(s, "energy_density", None)
             self.separation = _array(s, "separation", None)
+            if self.separation is not None and not np.isfinite(self.separation).any():
+                self.separation = None  # fewer than two particles: no pair, all NaN
             # Written by newer runs (docs/outputs-3d.md); None when absent.
             self.pair_angle = _array(s, "pair_angle", None)  # rad, closest pair vs field
             self.magnetostriction = _array(s, "magnetostriction", None)  # box strain along B
