@@ -16,6 +16,7 @@
 
 #include "../../support/hdf5_read.hpp"
 #include "../../support/temp_dir.hpp"
+#include "../support/cli_run.hpp"
 #include "../support/small_runs.hpp"
 #include "mresim/config/config_error.hpp"
 #include "mresim/mess/outputs/mess_outputs.hpp"
@@ -24,52 +25,18 @@ namespace mresim::mess_protocol {
 namespace {
 
 namespace fs = std::filesystem;
+using mresim::mess_protocol::testing::CliRun;
+using mresim::mess_protocol::testing::column_of;
+using mresim::mess_protocol::testing::csv_rows;
+using mresim::mess_protocol::testing::run_in;
 using mresim::testing::Hdf5Reader;
 using mresim::testing::read_text;
 using mresim::testing::TempDir;
-
-struct CliResult {
-  int status = -1;
-  std::string err;
-};
-
-// `mresim run run.toml --out out --no-plot` in `dir`; status and stderr.
-CliResult run_cli(const TempDir& dir, const std::string& toml) {
-  std::ofstream(dir / "run.toml") << toml;
-  const std::string command = "cd '" + dir.path().string() + "' && '" + MRESIM_CLI_PATH +
-                              "' run run.toml --out out --no-plot -j 1 >/dev/null 2>err.txt";
-  const int raw = std::system(command.c_str());
-  CliResult r;
-  if (WIFEXITED(raw)) r.status = WEXITSTATUS(raw);
-  r.err = read_text(dir / "err.txt");
-  return r;
-}
 
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
   const auto at = text.find(from);
   if (at == std::string::npos) throw std::logic_error("replaced: '" + from + "' not found");
   return text.replace(at, from.size(), to);
-}
-
-// CSV header names and the rows' cells.
-std::vector<std::vector<std::string>> csv_cells(const fs::path& file) {
-  std::vector<std::vector<std::string>> rows;
-  std::istringstream in(read_text(file));
-  for (std::string line; std::getline(in, line);) {
-    std::vector<std::string> cells;
-    std::istringstream l(line);
-    for (std::string cell; std::getline(l, cell, ',');) cells.push_back(cell);
-    rows.push_back(cells);
-  }
-  return rows;
-}
-
-std::size_t column(const std::vector<std::string>& header, const std::string& name) {
-  for (std::size_t i = 0; i < header.size(); ++i) {
-    if (header[i] == name) return i;
-  }
-  ADD_FAILURE() << "no column " << name;
-  return 0;
 }
 
 // ------------------------------------------------------------------ validation (exit 2)
@@ -86,7 +53,7 @@ TEST(MessValidation, SaturationMagnetizationThatOverflowsIsRefused) {
         << e.what();
   }
   const TempDir dir;
-  const CliResult r = run_cli(dir, toml);
+  const CliRun r = run_in(dir, toml);
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("particles.saturation_magnetization = 1e+308"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out" / "results.h5"));
@@ -99,7 +66,7 @@ TEST(MessValidation, YoungsModulusThatOverflowsIsRefused) {
   const std::string toml = replaced(testing::small_hysteresis(0.01, 1), "discretization_order = 1",
                                     "discretization_order = 1\nyoungs_modulus = 1e308");
   const TempDir dir;
-  const CliResult r = run_cli(dir, toml);
+  const CliRun r = run_in(dir, toml);
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("model.youngs_modulus = 1e+308"), std::string::npos) << r.err;
   EXPECT_NO_THROW((void)testing::spec_of(replaced(toml, "1e308", "1e6")));
@@ -186,7 +153,7 @@ TEST(MessInvalidResults, LeapfrogBlowUpIsPublishedMarkedAndExitsFour) {
                            "\n[solver]\nmethod = \"leapfrog\"\n[solver.leapfrog]\ndt = 0.1\n"
                            "steps_per_round = 200\nmax_rounds = 4\n";
   const TempDir dir;
-  const CliResult r = run_cli(dir, toml);
+  const CliRun r = run_in(dir, toml);
   ASSERT_EQ(r.status, 4) << r.err;
   EXPECT_NE(r.err.find("non-finite results: "), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("at step 0 (B = 0 T)"), std::string::npos) << r.err;
@@ -200,9 +167,9 @@ TEST(MessInvalidResults, LeapfrogBlowUpIsPublishedMarkedAndExitsFour) {
   for (const double e : h5.doubles("/steps/energies/total")) {
     EXPECT_FALSE(std::isinf(e));  // non-finite is written as NaN
   }
-  const auto rows = csv_cells(out / "summary.csv");
+  const auto rows = csv_rows(out / "summary.csv");
   ASSERT_EQ(rows.size(), 7U);
-  const std::size_t v = column(rows[0], "valid");
+  const std::size_t v = column_of(rows[0], "valid");
   for (std::size_t i = 1; i < rows.size(); ++i) EXPECT_EQ(rows[i][v], "0");
 }
 
@@ -215,7 +182,7 @@ TEST(MessInvalidResults, UnconvergedStrainRunExitsFourWithInvalidModuli) {
                              "\n[strain]\nkind = \"shear\"\nmax = 0.02\nsteps = 3\n"
                              "\n[output]\ncheckpoint_every = 0\n";
   const TempDir dir;
-  const CliResult r = run_cli(dir, strain + "\n[solver]\n[solver.minimiser]\nmax_iterations = 1\n");
+  const CliRun r = run_in(dir, strain + "\n[solver]\n[solver.minimiser]\nmax_iterations = 1\n");
   ASSERT_EQ(r.status, 4) << r.err;
   EXPECT_NE(
       r.err.find(
@@ -225,10 +192,10 @@ TEST(MessInvalidResults, UnconvergedStrainRunExitsFourWithInvalidModuli) {
   EXPECT_NE(r.err.find("invalid modulus fit, not a result: G_eff at |B| = 0 T (field 0)"),
             std::string::npos)
       << r.err;
-  const auto rows = csv_cells(dir / "out" / "modulus.csv");
+  const auto rows = csv_rows(dir / "out" / "modulus.csv");
   ASSERT_EQ(rows.size(), 2U);
-  EXPECT_EQ(rows[1][column(rows[0], "valid")], "0");
-  EXPECT_GE(std::stoi(rows[1][column(rows[0], "points")]), 3);
+  EXPECT_EQ(rows[1][column_of(rows[0], "valid")], "0");
+  EXPECT_GE(std::stoi(rows[1][column_of(rows[0], "points")]), 3);
   const Hdf5Reader h5(dir / "out" / "results.h5");
   EXPECT_EQ(h5.ints("/analysis/valid"), (std::vector<std::int64_t>{0}));
   EXPECT_NE(h5.strings("/analysis/problem")[0].find("did not converge"), std::string::npos);
@@ -242,23 +209,23 @@ TEST(MessOutputs, ModulusCsvHasPointsResidualAndValid) {
                              "\n[strain]\nkind = \"shear\"\nmax = 0.02\nsteps = 3\n"
                              "\n[output]\ncheckpoint_every = 0\n";
   const TempDir dir;
-  const CliResult r = run_cli(dir, strain);
+  const CliRun r = run_in(dir, strain);
   ASSERT_EQ(r.status, 0) << r.err;
-  const auto rows = csv_cells(dir / "out" / "modulus.csv");
+  const auto rows = csv_rows(dir / "out" / "modulus.csv");
   ASSERT_EQ(rows.size(), 2U);
   const auto& header = rows[0];
-  EXPECT_EQ(rows[1][column(header, "valid")], "1");
-  EXPECT_EQ(rows[1][column(header, "points")], "4");
-  EXPECT_GT(std::stod(rows[1][column(header, "G_eff_Pa")]), 0.0);
-  EXPECT_GE(std::stod(rows[1][column(header, "residual")]), 0.0);
+  EXPECT_EQ(rows[1][column_of(header, "valid")], "1");
+  EXPECT_EQ(rows[1][column_of(header, "points")], "4");
+  EXPECT_GT(std::stod(rows[1][column_of(header, "G_eff_Pa")]), 0.0);
+  EXPECT_GE(std::stod(rows[1][column_of(header, "residual")]), 0.0);
   const Hdf5Reader h5(dir / "out" / "results.h5");
   EXPECT_EQ(h5.ints("/steps/valid"), (std::vector<std::int64_t>{1, 1, 1, 1}));
   EXPECT_EQ(h5.ints("/analysis/valid"), (std::vector<std::int64_t>{1}));
   EXPECT_EQ(h5.strings("/analysis/problem")[0], "");
   // No kink on a polymer-dominated parabola: no second fit, NaN numbers, valid 0.
-  EXPECT_EQ(rows[1][column(header, "second_valid")], "0");
-  EXPECT_EQ(rows[1][column(header, "second_points")], "0");
-  EXPECT_TRUE(std::isnan(std::stod(rows[1][column(header, "second_modulus")])));
+  EXPECT_EQ(rows[1][column_of(header, "second_valid")], "0");
+  EXPECT_EQ(rows[1][column_of(header, "second_points")], "0");
+  EXPECT_TRUE(std::isnan(std::stod(rows[1][column_of(header, "second_modulus")])));
   EXPECT_EQ(h5.ints("/analysis/second_valid"), (std::vector<std::int64_t>{0}));
   EXPECT_TRUE(std::isnan(h5.doubles("/analysis/second_modulus")[0]));
   EXPECT_EQ(h5.strings("/analysis/second_problem")[0], "no kink");
