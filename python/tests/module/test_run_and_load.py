@@ -1,0 +1,129 @@
+"""mresim.run writes the run directory `mresim run` writes; load() reads it back; both give the
+arrays of the command line's results.h5 for the same run file."""
+
+import h5py
+import numpy as np
+import pytest
+
+import mresim
+from conftest import MESS_DICT, PAIR_TOML
+
+# Differ from run to run by design: when and how long, not what.
+RUN_DEPENDENT = {"created_utc", "wall_time", "input_file"}
+
+
+def h5_contents(path):
+    """{name: array or attribute value} of every dataset and attribute of a results.h5."""
+    contents = {}
+    with h5py.File(path, "r") as f:
+        def visit(name, item):
+            if name.split("/")[-1] in RUN_DEPENDENT:
+                return
+            if isinstance(item, h5py.Dataset):
+                contents[name] = item[()]
+            for key, value in item.attrs.items():
+                if key not in RUN_DEPENDENT:
+                    contents[f"{name}@{key}"] = value
+
+        visit("", f)
+        f.visititems(visit)
+    return contents
+
+
+def assert_same_contents(a, b):
+    assert sorted(a) == sorted(b)
+    for name in a:
+        np.testing.assert_array_equal(a[name], b[name], err_msg=name)
+
+
+@pytest.fixture(scope="module")
+def pair_runs(tmp_path_factory, cli):
+    """The pair run file run from Python and from the command line."""
+    directory = tmp_path_factory.mktemp("pair")
+    path = directory / "pair.toml"
+    path.write_text(PAIR_TOML)
+    results = mresim.run(path, directory / "python")
+    done = cli("run", path, "--out", directory / "cli", "--no-plot")
+    assert done.returncode == 0, done.stderr
+    return results, directory / "cli"
+
+
+def test_pair_run_equals_the_command_lines(pair_runs):
+    results, cli_dir = pair_runs
+    assert_same_contents(h5_contents(results.file), h5_contents(cli_dir / "results.h5"))
+    assert (cli_dir / "summary.csv").read_text() == open(results.path + "/summary.csv").read()
+
+
+def test_pair_results_as_arrays(pair_runs):
+    results, cli_dir = pair_runs
+    assert results.run_type == "pair_hysteresis" and results.valid
+    loop = results.cases[0]
+    with h5py.File(cli_dir / "results.h5", "r") as f:
+        np.testing.assert_array_equal(loop["separation"], f["cases/0/separation"][()])
+        np.testing.assert_array_equal(loop.energy.zeeman, f["cases/0/energy/zeeman"][()])
+        assert loop.critical_fields.attrs["HC2_T"] == f["cases/0/critical_fields"].attrs["HC2_T"]
+    assert loop.attrs["label"] == "single spring, axial"
+    np.testing.assert_allclose(results.table()["B_T"], loop["field"], rtol=1e-9, atol=1e-12)
+    assert results.config["springs"]["k"] == 1e-2
+
+
+def test_load_gives_the_same_results(pair_runs):
+    results, _ = pair_runs
+    again = mresim.load(results.path)
+    assert again.attrs == results.attrs
+    np.testing.assert_array_equal(again["cases/0/distance"], results.cases[0].distance)
+
+
+@pytest.fixture(scope="module")
+def mess_runs(tmp_path_factory, cli):
+    """A small 3D run from Python (a dict) and from the command line (its TOML)."""
+    directory = tmp_path_factory.mktemp("mess")
+    run = mresim.Run(MESS_DICT)
+    (directory / "mess.toml").write_text(run.toml)
+    results = run.run(directory / "python", threads=1)
+    done = cli("run", directory / "mess.toml", "--out", directory / "cli", "--no-plot",
+               "--threads", "1")
+    assert done.returncode == 0, done.stderr
+    return results, directory / "cli"
+
+
+def test_3d_run_equals_the_command_lines(mess_runs):
+    results, cli_dir = mess_runs
+    assert_same_contents(h5_contents(results.file), h5_contents(cli_dir / "results.h5"))
+    cli_results = mresim.load(cli_dir)
+    for step in results.position_steps():
+        np.testing.assert_array_equal(results.positions(step), cli_results.positions(step))
+
+
+def test_3d_results_as_arrays(mess_runs):
+    results, _ = mess_runs
+    steps = len(results.steps["index"])
+    particles = len(results.lattice["initial_centres"])
+    assert results.run_type == "mess_hysteresis" and particles == 2 and steps == 2
+    assert results.centres.shape == (steps, particles, 3)
+    assert results.magnetization.shape == (steps, particles, 3)
+    assert results.field.shape == (steps, 3)
+    assert set(results.energies) >= {"springs", "volume", "zeeman", "dipole", "total"}
+    np.testing.assert_array_equal(results.energies["total"], results["steps/energies/total"])
+    nodes = int(results.lattice.attrs["node_count"])
+    assert results.position_steps() == list(range(steps))
+    assert results.node_positions.shape == (steps, nodes, 3)
+    # At zero field nothing moves: the lattice is where it started.
+    np.testing.assert_allclose(results.positions(0), results.lattice["initial_positions"],
+                               atol=1e-12)
+    # At 100 mT the pair along the field draws together.
+    separation = results.steps["separation"]
+    assert separation[1] < separation[0]
+    assert results.steps.solver.status[0] == "converged"
+
+
+def test_temporary_run_directory_goes_with_its_results():
+    import gc
+    import os
+
+    results = mresim.run(PAIR_TOML)
+    path = results.path
+    assert os.path.isfile(os.path.join(path, "results.h5"))
+    del results
+    gc.collect()
+    assert not os.path.exists(path)
