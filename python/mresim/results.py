@@ -95,7 +95,7 @@ class Results:
     - every run: ``run_type``, ``title``, ``config`` (the run file that ran, as a dict),
       ``input_toml``, ``valid`` / ``invalid_results``, ``warnings``;
     - 3D runs (``mess_*``, docs/outputs-3d.md): ``steps``, ``lattice``, ``analysis``,
-      ``field`` (S x 3, T), ``energies`` ({term: S}, J), ``centres`` (S x N_p x 3, m),
+      ``field`` (S x 3, T), ``loads`` (S), ``energies`` ({term: S}, J), ``centres`` (S x N_p x 3, m),
       ``magnetization`` (S x N_p x 3, A/m), ``moduli`` (the ``/analysis`` fits),
       ``positions(step)`` / ``node_positions`` (with ``[output] node_positions = true``);
     - two-dipole runs: ``cases`` (one Group per case, ``/cases/<i>``, with its
@@ -220,6 +220,13 @@ class Results:
     def field(self):
         """Applied field B = mu0 H of every step (S x 3, T)."""
         return self._step_dataset("field")
+
+    @property
+    def loads(self):
+        """Applied load of every step (S: shear angle in rad, strain, twist angle or stress in
+        Pa, see ``steps.attrs``/docs/outputs-3d.md); ``steps["measured_strain"]`` is the strain
+        the moduli are fitted against."""
+        return self._step_dataset("load_value")
 
     @property
     def energies(self):

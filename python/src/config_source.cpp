@@ -27,7 +27,7 @@ toml::table toml_table_of(const py::dict& tables, const std::string& prefix) {
       throw config::ConfigError(fmt::format("run-file key {}{}: keys must be strings", prefix,
                                             py::repr(name).cast<std::string>()));
     }
-    const std::string key = name.cast<std::string>();
+    const auto key = name.cast<std::string>();
     auto node = toml_node_of(value, prefix + key);
     out.insert_or_assign(key, std::move(*node));
   }

@@ -103,6 +103,7 @@ def test_3d_results_as_arrays(mess_runs):
     assert results.centres.shape == (steps, particles, 3)
     assert results.magnetization.shape == (steps, particles, 3)
     assert results.field.shape == (steps, 3)
+    np.testing.assert_array_equal(results.loads, np.zeros(steps))  # a field loop: no load
     assert set(results.energies) >= {"springs", "volume", "zeeman", "dipole", "total"}
     np.testing.assert_array_equal(results.energies["total"], results["steps/energies/total"])
     nodes = int(results.lattice.attrs["node_count"])
@@ -127,3 +128,28 @@ def test_temporary_run_directory_goes_with_its_results():
     del results
     gc.collect()
     assert not os.path.exists(path)
+
+
+def test_invalid_results_raise_with_the_results_attached(tmp_path, cli):
+    # One minimiser iteration cannot relax the 100 mT step: unconverged, status 4 on the CLI.
+    overrides = ["solver.minimiser.max_iterations=1"]
+    with pytest.raises(mresim.InvalidResultsError) as raised:
+        mresim.run(MESS_DICT, tmp_path / "python", overrides=overrides)
+    results = raised.value.results
+    assert not results.valid
+    assert list(results.steps["valid"]) == [1, 0]
+    (tmp_path / "mess.toml").write_text(mresim.Run(MESS_DICT).toml)
+    done = cli("run", tmp_path / "mess.toml", "--out", tmp_path / "cli", "--no-plot",
+               "--set", overrides[0])
+    assert done.returncode == 4
+    assert f"mresim: error: {raised.value};" in done.stderr
+    # check=False returns them instead.
+    assert not mresim.run(MESS_DICT, overrides=overrides, check=False).valid
+
+
+def test_python_signal_handlers_are_back_after_a_run():
+    import signal
+
+    before = signal.getsignal(signal.SIGINT)
+    mresim.run(PAIR_TOML)
+    assert signal.getsignal(signal.SIGINT) is before
