@@ -5,11 +5,16 @@ import math
 import os
 import shutil
 import tempfile
+import threading
 import tomllib
 import warnings
 
 from . import _core
 from .results import load
+
+# Runs in one process take turns: each uses every core it is given (OpenMP threads are a
+# process-wide setting) and installs the process's SIGINT/SIGTERM handlers while it computes.
+_one_run_at_a_time = threading.Lock()
 
 
 class InvalidResultsError(RuntimeError):
@@ -116,7 +121,8 @@ class Run:
         check:   raise :class:`InvalidResultsError` (results attached) when some results are
                  non-finite or unconverged; with False, look at ``results.invalid_results``.
 
-        The computation releases the GIL. Ctrl-C (or a notebook's interrupt) stops it at its
+        The computation releases the GIL; runs started from several Python threads take
+        turns. Ctrl-C (or a notebook's interrupt) stops it at its
         next safe point, as on the command line, and raises KeyboardInterrupt; a 3D run then
         keeps its checkpoint in ``out`` for ``mresim resume``.
         """
@@ -127,7 +133,8 @@ class Run:
             out = os.path.join(temporary, "run")
         out = os.fspath(out)
         try:
-            status = self._plan.execute(out, thread_count, bool(force), bool(plot))
+            with _one_run_at_a_time:
+                status = self._plan.execute(out, thread_count, bool(force), bool(plot))
             if status >= 128:
                 where = (
                     "nothing was kept (temporary directory)"

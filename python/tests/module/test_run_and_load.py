@@ -153,3 +153,21 @@ def test_python_signal_handlers_are_back_after_a_run():
     before = signal.getsignal(signal.SIGINT)
     mresim.run(PAIR_TOML)
     assert signal.getsignal(signal.SIGINT) is before
+
+
+def test_runs_from_two_threads_give_the_same_results():
+    import threading
+
+    results = [None, None]
+
+    def run(i):
+        results[i] = mresim.run(PAIR_TOML).cases[0]["distance"]
+
+    threads = [threading.Thread(target=run, args=(i,)) for i in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert results[0] is not None and results[1] is not None  # neither thread failed
+    np.testing.assert_array_equal(results[0], results[1])
+
