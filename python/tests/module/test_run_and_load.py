@@ -171,3 +171,28 @@ def test_runs_from_two_threads_give_the_same_results():
     assert results[0] is not None and results[1] is not None  # neither thread failed
     np.testing.assert_array_equal(results[0], results[1])
 
+
+
+def test_the_gil_is_released_while_a_run_computes(tmp_path):
+    import threading
+    import time
+
+    plan = mresim.Run(MESS_DICT)._plan
+    stamps, stop = [], threading.Event()
+
+    def spin():  # needs the GIL for every sample it takes
+        while not stop.is_set():
+            stamps.append(time.perf_counter())
+            time.sleep(0.001)
+
+    spinner = threading.Thread(target=spin)
+    spinner.start()
+    time.sleep(0.01)
+    start = time.perf_counter()
+    plan.execute(str(tmp_path / "run"), 1, False, False)
+    # Taken after this thread has the GIL back: a spinner that only got it after the run
+    # returned has samples just before `end`, none in the run's first half.
+    end = time.perf_counter()
+    stop.set()
+    spinner.join()
+    assert any(start < s < start + 0.5 * (end - start) for s in stamps)
