@@ -110,7 +110,7 @@ class RerunPlan final : public app::RunPlan {
 
     // The new result replaces the old one everywhere the run keeps it.
     saved.records[step_] = record;
-    const bool positions_kept = saved.positions.count(step_) != 0;
+    const bool positions_kept = saved.positions.contains(step_);
     if (positions_kept) saved.positions[step_] = rerunner.system().positions();
     for (std::size_t k = 0; k < saved.steps.size(); ++k) {
       const fs::path kept = step_positions_file(run_dir_, k);

@@ -76,7 +76,7 @@ SavedRun read_saved_run(const fs::path& dir, const ProtocolRunner& runner,
   }
   for (std::size_t k = 0; k < saved.steps.size(); ++k) {
     const fs::path file = step_positions_file(dir, k);
-    if (saved.positions.count(k) != 0 || !fs::exists(file, ec)) continue;
+    if (saved.positions.contains(k) || !fs::exists(file, ec)) continue;
     const io::Hdf5Reader in(file);
     saved.positions[k] = read_columns(in, "/positions");
   }
@@ -107,7 +107,7 @@ StateSources sources_after(const SavedRun& saved, const ProtocolState& initial, 
 
 bool kept(const SavedRun& saved, const std::vector<std::optional<std::size_t>>& steps) {
   for (const auto& k : steps) {
-    if (k && saved.positions.count(*k) == 0) return false;
+    if (k && !saved.positions.contains(*k)) return false;
   }
   return true;
 }
