@@ -46,7 +46,7 @@ TEST(MessExtendCli, HigherFieldContinuesFromTheFinalStateAsTheDirectRun) {
   // Recorded as the run file it now is, and in the history.
   EXPECT_EQ(r.string_attribute("/", "input_toml"),
             Hdf5Reader(dir / "direct" / "results.h5").string_attribute("/", "input_toml"));
-  EXPECT_EQ(r.string_attribute("/", "input_overrides"), "field.max=0.08\nfield.steps=4");
+  EXPECT_EQ(r.string_attribute("/", "input_overrides"), "field.max=0.08\nfield.steps=4\n");
   EXPECT_EQ(r.string_attribute("/history/0", "kind"), "extend");
   EXPECT_EQ(r.string_attribute("/history/0", "overrides"), "field.max=0.08\nfield.steps=4");
   EXPECT_EQ(r.string_attribute("/history/0", "command_line"),
@@ -93,9 +93,8 @@ TEST(MessExtendCli, LargerLoopReplacesTheOldReturnBranchFromKeptPositions) {
   EXPECT_EQ(r.ints("/history/0/added_steps"),
             (std::vector<std::int64_t>{3, 4, 5, 11, 12, 13, 19, 20}));
   for (int k = 0; k < 21; ++k) {
-    EXPECT_TRUE(
-        fs::exists(dir / "out" / "positions" /
-                   ("step_00000" + std::to_string(k / 10) + std::to_string(k % 10) + ".h5")))
+    EXPECT_TRUE(fs::exists(dir / "out" / "positions" /
+                           ("step_0000" + std::to_string(k / 10) + std::to_string(k % 10) + ".h5")))
         << k;
   }
 }
@@ -198,7 +197,7 @@ TEST(MessExtendCli, KilledExtendLeavesTheRunAsItWasAndResumes) {
   expect_identical_steps(dir / "direct", dir / "out");
   const Hdf5Reader r(dir / "out" / "results.h5");
   EXPECT_EQ(r.string_attribute("/history/0", "kind"), "extend");  // kept across the resume
-  EXPECT_EQ(r.string_attribute("/", "input_overrides"), "field.max=0.32\nfield.steps=16");
+  EXPECT_EQ(r.string_attribute("/", "input_overrides"), "field.max=0.32\nfield.steps=16\n");
 }
 
 }  // namespace

@@ -106,10 +106,8 @@ StateSources sources_after(const SavedRun& saved, const ProtocolState& initial, 
 }
 
 bool kept(const SavedRun& saved, const std::vector<std::optional<std::size_t>>& steps) {
-  for (const auto& k : steps) {
-    if (k && !saved.positions.contains(*k)) return false;
-  }
-  return true;
+  return std::ranges::all_of(steps,
+                             [&](const auto& k) { return !k || saved.positions.contains(*k); });
 }
 
 bool restorable(const SavedRun& saved, const ProtocolState& initial, std::size_t count) {
