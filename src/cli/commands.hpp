@@ -53,6 +53,27 @@ struct ResumeOptions {
 CLI::App* add_resume_command(CLI::App& app, ResumeOptions& options);
 int resume_command(const ResumeOptions& options);
 
+// `mresim extend DIR --set ...` and `mresim rerun DIR --step K`: continue a finished 3D run
+// (extend_command.cpp, rerun_command.cpp; docs/cli.md).
+struct ExtendOptions {
+  std::string dir;
+  std::vector<std::string> overrides;  // --set KEY=VALUE: only keys that lengthen the protocol
+  long threads = -1;
+  bool no_plot = false;
+};
+CLI::App* add_extend_command(CLI::App& app, ExtendOptions& options);
+int extend_command(const ExtendOptions& options);
+
+struct RerunOptions {
+  std::string dir;
+  long step = -1;
+  std::vector<std::string> overrides;  // --set solver.KEY=VALUE
+  long threads = -1;
+  bool no_plot = false;
+};
+CLI::App* add_rerun_command(CLI::App& app, RerunOptions& options);
+int rerun_command(const RerunOptions& options);
+
 struct InfoOptions {
   std::string file;
   bool json = false;

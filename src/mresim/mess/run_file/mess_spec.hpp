@@ -168,8 +168,9 @@ struct AnalysisSpec {
 };
 
 struct OutputSpec {
-  bool node_positions = false;  // write all node positions per step (large)
-  long checkpoint_every = 1;    // steps between checkpoints; 0 = none
+  bool node_positions = false;   // write all node positions per step (large)
+  long checkpoint_every = 1;     // steps between checkpoints; 0 = none
+  bool keep_final_state = true;  // final_state.h5 in the results, for `mresim extend`/`rerun`
 };
 
 // ---------------------------------------------------------------------------------------------

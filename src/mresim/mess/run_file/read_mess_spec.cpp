@@ -812,6 +812,7 @@ MessSpec read_mess_spec(const TableReader& root, std::string_view run_type) {
   if (const auto t = root.optional_table("output")) {
     s.output.node_positions = t->boolean_or("node_positions", false);
     s.output.checkpoint_every = t->integer_or("checkpoint_every", 1, Range::between(0, 1e9));
+    s.output.keep_final_state = t->boolean_or("keep_final_state", true);
   }
   return s;
 }

@@ -2,7 +2,9 @@
 // which calls mess_run_type below). One plan for all: the run file's MessSpec holds the
 // protocol the ProtocolRunner follows. Checkpoints go to the staging directory after every
 // [output] checkpoint_every steps; `mresim resume` hands the interrupted staging directory back
-// to execute(), which continues from its checkpoint.
+// to execute(), which continues from its checkpoint. `mresim extend` prepares a staging
+// directory the same way (restart/extend_plan.hpp). A finished run keeps its final state
+// (final_state.h5) for extend and rerun.
 
 #include "mresim/mess/runs/mess_runs.hpp"
 
@@ -19,6 +21,8 @@
 #include "mresim/mess/outputs/checkpoint.hpp"
 #include "mresim/mess/outputs/mess_outputs.hpp"
 #include "mresim/mess/protocols/protocol_runner.hpp"
+#include "mresim/mess/restart/run_history.hpp"
+#include "mresim/mess/restart/saved_run.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
 #include "mresim/mess/solvers/amg_preconditioner.hpp"
 #include "mresim/pair/runs/pair_outputs.hpp"
@@ -80,14 +84,20 @@ class MessPlan final : public app::RunPlan {
     });
 
     const MessResultCheck check = write_mess_results(staging_dir, results, runner, state.records);
+    publish_pending_history(staging_dir, results, runner);          // an extended run's /history
     pair::runs::write_warnings_attribute(results, spec_.warnings);  // /@warnings, as pair runs
     warn_about_intermediate_solves(state.records);
     for (const std::string& fit : check.invalid_fits) {
       std::cerr << "mresim: warning: invalid modulus fit, not a result: " << fit
                 << " (marked in /analysis/valid and modulus.csv)\n";
     }
+    // The state after the last step stays with the results, for `mresim extend` and `rerun`
+    // (restart/saved_run.hpp); the checkpoint is not needed any more.
+    if (spec_.output.keep_final_state) {
+      write_checkpoint(staging_dir / kFinalStateFile, state, runner, input_toml_, input_name_);
+    }
     std::error_code ec;
-    fs::remove(checkpoint, ec);  // the results hold everything now
+    fs::remove(checkpoint, ec);
     // Non-finite or unconverged steps: the results stay, marked; `mresim run` exits with 4.
     const std::string invalid = check.message();
     if (!invalid.empty()) throw app::InvalidResults(invalid);

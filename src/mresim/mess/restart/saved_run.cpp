@@ -1,0 +1,156 @@
+#include "mresim/mess/restart/saved_run.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "mresim/io/hdf5_reader.hpp"
+#include "mresim/mess/outputs/checkpoint.hpp"
+#include "mresim/mess/outputs/mess_outputs.hpp"
+#include "mresim/mess/outputs/step_records_io.hpp"
+
+namespace mresim::mess_protocol {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The slot a step's result goes to in a state with `slots` slots (protocol_runner.cpp).
+std::size_t slot_of(const StepSpec& step, std::size_t slots) {
+  return slots > 1 ? step.field_index : 0;
+}
+
+// The final state's slots and references hold the results of these steps.
+void take_final_state(const ProtocolState& final, const std::vector<StepSpec>& steps,
+                      std::map<std::size_t, Eigen::Matrix3Xd>& positions) {
+  std::vector<std::optional<std::size_t>> last_in_slot(final.slots.size());
+  std::vector<std::optional<std::size_t>> reference_step(final.references.size());
+  for (std::size_t k = 0; k < final.next_step; ++k) {
+    last_in_slot.at(slot_of(steps[k], final.slots.size())) = k;
+    if (steps[k].load_index == 0 && !final.references.empty()) {
+      reference_step.at(steps[k].field_index) = k;
+    }
+  }
+  for (std::size_t s = 0; s < last_in_slot.size(); ++s) {
+    if (last_in_slot[s] && final.slots[s].positions.cols() > 0) {
+      positions[*last_in_slot[s]] = final.slots[s].positions;
+    }
+  }
+  for (std::size_t f = 0; f < reference_step.size(); ++f) {
+    if (reference_step[f] && final.references[f].cols() > 0) {
+      positions[*reference_step[f]] = final.references[f];
+    }
+  }
+}
+
+}  // namespace
+
+SavedRun read_saved_run(const fs::path& dir, const ProtocolRunner& runner,
+                        const std::string& input_toml) {
+  SavedRun saved;
+  saved.steps = runner.steps();
+  const fs::path final_state = dir / kFinalStateFile;
+  std::error_code ec;
+  if (fs::exists(final_state, ec)) {
+    // The exact records (results.h5 writes non-finite numbers as NaN) and the final positions.
+    const ProtocolState final = read_checkpoint(final_state, runner, input_toml);
+    if (final.next_step != saved.steps.size()) {
+      throw std::runtime_error(fmt::format("{} holds the state after {} of {} steps",
+                                           final_state.string(), final.next_step,
+                                           saved.steps.size()));
+    }
+    take_final_state(final, saved.steps, saved.positions);
+    saved.records = final.records;
+    saved.has_final_state = true;
+  } else {
+    const io::Hdf5Reader results(dir / "results.h5");
+    saved.records =
+        read_step_records(results, "/steps", saved.steps, runner.system().particle_count(),
+                          runner.system().energy_labels());
+    if (saved.records.size() != saved.steps.size()) {
+      throw std::runtime_error(fmt::format("{} holds {} of the run's {} steps",
+                                           (dir / "results.h5").string(), saved.records.size(),
+                                           saved.steps.size()));
+    }
+  }
+  for (std::size_t k = 0; k < saved.steps.size(); ++k) {
+    const fs::path file = step_positions_file(dir, k);
+    if (saved.positions.contains(k) || !fs::exists(file, ec)) continue;
+    const io::Hdf5Reader in(file);
+    saved.positions[k] = read_columns(in, "/positions");
+  }
+  return saved;
+}
+
+namespace {
+
+// The steps whose results the state after `count` steps holds: the latest step of each slot and
+// the zero-load step of each field (nullopt: untouched, the initial lattice).
+struct StateSources {
+  std::vector<std::optional<std::size_t>> slots;
+  std::vector<std::optional<std::size_t>> references;
+};
+
+StateSources sources_after(const SavedRun& saved, const ProtocolState& initial, std::size_t count) {
+  StateSources sources{std::vector<std::optional<std::size_t>>(initial.slots.size()),
+                       std::vector<std::optional<std::size_t>>(initial.references.size())};
+  for (std::size_t k = 0; k < count; ++k) {
+    const StepSpec& step = saved.steps[k];
+    sources.slots.at(slot_of(step, initial.slots.size())) = k;
+    if (step.load_index == 0 && !initial.references.empty()) {
+      sources.references.at(step.field_index) = k;
+    }
+  }
+  return sources;
+}
+
+bool kept(const SavedRun& saved, const std::vector<std::optional<std::size_t>>& steps) {
+  return std::ranges::all_of(steps,
+                             [&](const auto& k) { return !k || saved.positions.contains(*k); });
+}
+
+bool restorable(const SavedRun& saved, const ProtocolState& initial, std::size_t count) {
+  if (count > saved.records.size() || count > saved.steps.size()) return false;
+  const StateSources sources = sources_after(saved, initial, count);
+  return kept(saved, sources.slots) && kept(saved, sources.references);
+}
+
+}  // namespace
+
+std::optional<ProtocolState> state_after(const SavedRun& saved, const ProtocolRunner& runner,
+                                         std::size_t count) {
+  ProtocolState state = runner.initial_state();
+  if (count > runner.steps().size() || !restorable(saved, state, count)) return std::nullopt;
+  const StateSources sources = sources_after(saved, state, count);
+  for (std::size_t s = 0; s < state.slots.size(); ++s) {
+    if (!sources.slots[s]) continue;
+    state.slots[s].positions = saved.positions.at(*sources.slots[s]);
+    state.slots[s].magnetization = saved.records[*sources.slots[s]].magnetization;
+  }
+  for (std::size_t f = 0; f < state.references.size(); ++f) {
+    if (sources.references[f]) state.references[f] = saved.positions.at(*sources.references[f]);
+  }
+  state.records.assign(saved.records.begin(),
+                       saved.records.begin() + static_cast<std::ptrdiff_t>(count));
+  state.next_step = count;
+  return state;
+}
+
+std::size_t last_restorable(const SavedRun& saved, const ProtocolRunner& runner,
+                            std::size_t count) {
+  const ProtocolState initial = runner.initial_state();
+  for (std::size_t k = std::min(count, runner.steps().size()); k > 0; --k) {
+    if (restorable(saved, initial, k)) return k;
+  }
+  return 0;
+}
+
+void carry_kept_file(const fs::path& from, const fs::path& to) {
+  fs::create_directories(to.parent_path());
+  std::error_code ec;
+  fs::create_hard_link(from, to, ec);
+  if (ec) fs::copy_file(from, to, fs::copy_options::overwrite_existing);
+}
+
+}  // namespace mresim::mess_protocol
