@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <hdf5.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
@@ -21,8 +22,10 @@ using mresim::testing::TempDir;
 
 TEST(Hdf5FileViews, CompressedArraysRoundTripInChunksWithShuffleAndGzip) {
   const TempDir dir;
-  std::vector<double> values(3 * 1000);
-  for (std::size_t i = 0; i < values.size(); ++i) values[i] = 1e-6 * std::sin(0.01 * i);
+  std::vector<double> values(std::size_t{3} * 1000);
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    values[i] = 1e-6 * std::sin(0.01 * static_cast<double>(i));
+  }
   {
     Hdf5File h5(dir / "p.h5");
     h5.write_compressed_array("/positions", {1000, 3}, values, "m", 256);
@@ -39,8 +42,10 @@ TEST(Hdf5FileViews, CompressedArraysRoundTripInChunksWithShuffleAndGzip) {
   std::array<hsize_t, 2> chunk{};
   EXPECT_EQ(H5Pget_chunk(creation, 2, chunk.data()), 2);
   EXPECT_EQ(chunk, (std::array<hsize_t, 2>{256, 3}));
+  const int filter_count = H5Pget_nfilters(creation);
   std::vector<H5Z_filter_t> filters;
-  for (int i = 0; i < H5Pget_nfilters(creation); ++i) {
+  filters.reserve(static_cast<std::size_t>(std::max(filter_count, 0)));
+  for (int i = 0; i < filter_count; ++i) {
     filters.push_back(H5Pget_filter2(creation, static_cast<unsigned>(i), nullptr, nullptr, nullptr,
                                      0, nullptr, nullptr));
   }
