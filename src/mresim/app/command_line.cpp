@@ -6,12 +6,12 @@ namespace mresim::app {
 
 namespace {
 
-std::string& stored() {
+std::string& command_line_storage() {
   static std::string line;
   return line;
 }
 
-bool plain(const std::string& argument) {
+bool needs_no_quotes(const std::string& argument) {
   constexpr std::string_view kSafe =
       "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-+=.,/:@%";
   return !argument.empty() && argument.find_first_not_of(kSafe) == std::string::npos;
@@ -20,7 +20,7 @@ bool plain(const std::string& argument) {
 }  // namespace
 
 std::string shell_quoted(const std::string& argument) {
-  if (plain(argument)) return argument;
+  if (needs_no_quotes(argument)) return argument;
   std::string out = "'";
   for (const char c : argument) {
     if (c == '\'') {
@@ -38,9 +38,9 @@ void set_command_line(int argc, const char* const* argv) {
     if (i > 0) line += ' ';
     line += shell_quoted(argv[i]);
   }
-  stored() = line;
+  command_line_storage() = line;
 }
 
-const std::string& command_line() { return stored(); }
+const std::string& command_line() { return command_line_storage(); }
 
 }  // namespace mresim::app

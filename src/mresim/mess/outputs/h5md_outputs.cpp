@@ -15,8 +15,8 @@ namespace {
 
 constexpr const char* kParticles = "/particles/magnetic_particles";
 // The one step and time of every time-dependent element (the others link to them).
-constexpr const char* kStep = "/particles/magnetic_particles/position/step";
-constexpr const char* kTime = "/particles/magnetic_particles/position/time";
+constexpr const char* kH5mdStep = "/particles/magnetic_particles/position/step";
+constexpr const char* kH5mdTime = "/particles/magnetic_particles/position/time";
 constexpr double kNanometresPerMetre = 1e9;
 
 // The login name of the user running mresim (H5MD's author); "unknown" when there is none.
@@ -41,8 +41,8 @@ void write_h5md_group(io::Hdf5File& results) {
 // A time-dependent H5MD element at `group`: its value is the existing dataset `value` (hard
 // link), its step and time the shared ones.
 void link_element(io::Hdf5File& results, const std::string& group, const std::string& value) {
-  results.hard_link(kStep, group + "/step");
-  results.hard_link(kTime, group + "/time");
+  results.hard_link(kH5mdStep, group + "/step");
+  results.hard_link(kH5mdTime, group + "/time");
   results.hard_link(value, group + "/value");
 }
 
@@ -64,9 +64,9 @@ void write_magnetic_particles(io::Hdf5File& results, const std::vector<StepRecor
     step.push_back(static_cast<std::int64_t>(r.step.index));
     time.push_back(static_cast<double>(r.step.index));
   }
-  results.write_int_vector(kStep, step);
+  results.write_int_vector(kH5mdStep, step);
   // No unit: the time of a quasi-static step is its index (docs/outputs-3d.md, "H5MD").
-  results.write_vector(kTime, time, {});
+  results.write_vector(kH5mdTime, time, {});
   // Nanometres: MDAnalysis' H5MD reader refuses lengths in m (it knows Angstrom, nm, pm, fm).
   std::vector<double> nm;
   nm.reserve(records.size() * particle_count * 3);
@@ -92,8 +92,8 @@ void write_nodes(io::Hdf5File& results, const std::vector<StepRecord>& records,
     sources.emplace_back(step_positions_file("", r.step.index).string(), "/positions");
   }
   results.write_virtual_stack(g + "/position/value", {node_count, 3}, sources, "m");
-  results.hard_link(kStep, g + "/position/step");
-  results.hard_link(kTime, g + "/position/time");
+  results.hard_link(kH5mdStep, g + "/position/step");
+  results.hard_link(kH5mdTime, g + "/position/time");
   results.hard_link("/lattice/particle_id", g + "/particle_id");
 }
 
