@@ -11,6 +11,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/exit_status.hpp"
+#include "mresim/app/command_line.hpp"
 #include "mresim/app/stop_signal.hpp"
 #include "mresim/config/config_error.hpp"
 #include "mresim/io/run_directory.hpp"
@@ -24,6 +25,7 @@ int report_error(const char* message, int status) {
 
 int run_cli(int argc, char** argv) {
   using namespace mresim::cli;
+  mresim::app::set_command_line(argc, argv);  // recorded in results.h5 (io/metadata.hpp)
 
   CLI::App app{
       "mresim: particle-resolved simulation of magnetorheological elastomers.\n"

@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 #include <hdf5.h>
 
+#include <algorithm>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 #include <type_traits>
@@ -145,7 +147,7 @@ std::int64_t Hdf5File::open_object(std::string_view object_path) {
 }
 
 void Hdf5File::write_attribute(std::string_view object_path, std::string_view name,
-                               std::int64_t type, const void* value) {
+                               std::int64_t type, const void* value, std::size_t count) {
   require_open(object_path);
   const Handle object(open_object(object_path), H5Oclose);
   const SilenceHdf5Errors silence;
@@ -155,7 +157,9 @@ void Hdf5File::write_attribute(std::string_view object_path, std::string_view na
       H5Adelete(object.get(), attribute_name.c_str()) < 0) {
     fail("cannot replace attribute", where);
   }
-  const Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  const auto extent = static_cast<hsize_t>(count);
+  const Handle space(count == 0 ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &extent, nullptr),
+                     H5Sclose);
   const Handle attribute(
       H5Acreate2(object.get(), attribute_name.c_str(), type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
       H5Aclose);
@@ -182,9 +186,23 @@ void Hdf5File::write_int_attribute(std::string_view object_path, std::string_vie
   write_attribute(object_path, name, H5T_NATIVE_INT64, &value);
 }
 
+void Hdf5File::write_int_vector_attribute(std::string_view object_path, std::string_view name,
+                                          const std::vector<std::int64_t>& values) {
+  write_attribute(object_path, name, H5T_NATIVE_INT64, values.data(), values.size());
+}
+
+void Hdf5File::write_string_vector_attribute(std::string_view object_path, std::string_view name,
+                                             const std::vector<std::string>& values) {
+  std::vector<const char*> pointers;
+  pointers.reserve(values.size());
+  for (const auto& v : values) pointers.push_back(v.c_str());
+  const Handle type = string_type();
+  write_attribute(object_path, name, type.get(), pointers.data(), values.size());
+}
+
 void Hdf5File::write_dataset(std::string_view dataset_path, std::int64_t file_type,
                              std::int64_t memory_type, const std::vector<std::size_t>& dims,
-                             const void* data, std::string_view unit) {
+                             const void* data, std::string_view unit, std::int64_t creation) {
   require_open(dataset_path);
   if (dims.empty()) {
     throw std::invalid_argument(fmt::format("dataset '{}' in '{}' needs at least one dimension",
@@ -201,7 +219,7 @@ void Hdf5File::write_dataset(std::string_view dataset_path, std::int64_t file_ty
   const Handle lcpl(H5Pcreate(H5P_LINK_CREATE), H5Pclose);
   H5Pset_create_intermediate_group(lcpl.get(), 1);
   const Handle dataset(H5Dcreate2(file_, absolute(dataset_path).c_str(), file_type, space.get(),
-                                  lcpl.get(), H5P_DEFAULT, H5P_DEFAULT),
+                                  lcpl.get(), creation, H5P_DEFAULT),
                        H5Dclose);
   if (!dataset.valid()) fail("cannot create dataset", dataset_path);
   const auto count = std::accumulate(dims.begin(), dims.end(), std::size_t{1},
@@ -260,6 +278,82 @@ void Hdf5File::write_string_vector(std::string_view dataset_path,
   for (const auto& v : values) pointers.push_back(v.c_str());
   const Handle type = string_type();
   write_dataset(dataset_path, type.get(), type.get(), {values.size()}, pointers.data(), {});
+}
+
+void Hdf5File::write_compressed_array(std::string_view dataset_path,
+                                      const std::vector<std::size_t>& dims,
+                                      const std::vector<double>& c_order, std::string_view unit,
+                                      std::size_t chunk_rows) {
+  check_shape(dataset_path, dims, c_order.size());
+  // A chunk must not be empty and no dimension may be 0 in a chunked layout's chunk shape;
+  // an empty dataset is written contiguous (there is nothing to compress).
+  if (dims.empty() || c_order.empty() || chunk_rows == 0) {
+    write_array(dataset_path, dims, c_order, unit);
+    return;
+  }
+  std::vector<hsize_t> chunk(dims.begin(), dims.end());
+  chunk[0] = std::min<hsize_t>(chunk[0], chunk_rows);
+  const SilenceHdf5Errors silence;
+  const Handle creation(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  if (H5Pset_chunk(creation.get(), static_cast<int>(chunk.size()), chunk.data()) < 0 ||
+      H5Pset_shuffle(creation.get()) < 0 || H5Pset_deflate(creation.get(), 1) < 0) {
+    fail("cannot set up compression for", dataset_path);
+  }
+  write_dataset(dataset_path, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, c_order.data(), unit,
+                creation.get());
+}
+
+void Hdf5File::write_virtual_stack(std::string_view dataset_path,
+                                   const std::vector<std::size_t>& item_dims,
+                                   const std::vector<std::pair<std::string, std::string>>& sources,
+                                   std::string_view unit) {
+  require_open(dataset_path);
+  if (exists(dataset_path)) {
+    throw std::runtime_error(fmt::format("cannot write dataset '{}' in '{}': it already exists",
+                                         absolute(dataset_path), path_.string()));
+  }
+  std::vector<hsize_t> extent = {sources.size()};
+  extent.insert(extent.end(), item_dims.begin(), item_dims.end());
+  const std::vector<hsize_t> item(item_dims.begin(), item_dims.end());
+  const SilenceHdf5Errors silence;
+  const Handle space(H5Screate_simple(static_cast<int>(extent.size()), extent.data(), nullptr),
+                     H5Sclose);
+  const Handle source_space(H5Screate_simple(static_cast<int>(item.size()), item.data(), nullptr),
+                            H5Sclose);
+  const Handle creation(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  const double fill = std::numeric_limits<double>::quiet_NaN();
+  H5Pset_fill_value(creation.get(), H5T_NATIVE_DOUBLE, &fill);
+  std::vector<hsize_t> start(extent.size(), 0);
+  std::vector<hsize_t> count = extent;
+  count[0] = 1;
+  for (std::size_t i = 0; i < sources.size(); ++i) {
+    start[0] = i;
+    if (H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(),
+                            nullptr) < 0 ||
+        H5Pset_virtual(creation.get(), space.get(), sources[i].first.c_str(),
+                       sources[i].second.c_str(), source_space.get()) < 0) {
+      fail("cannot map '" + sources[i].first + "' into", dataset_path);
+    }
+  }
+  H5Sselect_all(space.get());
+  const Handle lcpl(H5Pcreate(H5P_LINK_CREATE), H5Pclose);
+  H5Pset_create_intermediate_group(lcpl.get(), 1);
+  const Handle dataset(H5Dcreate2(file_, absolute(dataset_path).c_str(), H5T_IEEE_F64LE,
+                                  space.get(), lcpl.get(), creation.get(), H5P_DEFAULT),
+                       H5Dclose);
+  if (!dataset.valid()) fail("cannot create virtual dataset", dataset_path);
+  if (!unit.empty()) write_string_attribute(dataset_path, "unit", unit);
+}
+
+void Hdf5File::hard_link(std::string_view existing_path, std::string_view new_path) {
+  require_open(new_path);
+  const SilenceHdf5Errors silence;
+  const Handle lcpl(H5Pcreate(H5P_LINK_CREATE), H5Pclose);
+  H5Pset_create_intermediate_group(lcpl.get(), 1);
+  if (H5Lcreate_hard(file_, absolute(existing_path).c_str(), file_, absolute(new_path).c_str(),
+                     lcpl.get(), H5P_DEFAULT) < 0) {
+    fail("cannot link to '" + absolute(existing_path) + "' as", new_path);
+  }
 }
 
 void Hdf5File::flush() {

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace mresim::io {
@@ -40,6 +41,11 @@ class Hdf5File {
                               std::string_view value);
   void write_number_attribute(std::string_view object_path, std::string_view name, double value);
   void write_int_attribute(std::string_view object_path, std::string_view name, std::int64_t value);
+  // One-dimensional attributes (H5MD's `version` [1, 1], a box's `boundary` per axis).
+  void write_int_vector_attribute(std::string_view object_path, std::string_view name,
+                                  const std::vector<std::int64_t>& values);
+  void write_string_vector_attribute(std::string_view object_path, std::string_view name,
+                                     const std::vector<std::string>& values);
 
   void write_vector(std::string_view dataset_path, const std::vector<double>& values,
                     std::string_view unit);
@@ -56,6 +62,22 @@ class Hdf5File {
   void write_int_array(std::string_view dataset_path, const std::vector<std::size_t>& dims,
                        const std::vector<std::int64_t>& c_order);
   void write_string_vector(std::string_view dataset_path, const std::vector<std::string>& values);
+  // Like write_array, stored in chunks of at most `chunk_rows` along the first dimension (the
+  // other dimensions whole) and compressed with the shuffle filter + gzip level 1: shuffling
+  // groups the bytes of neighbouring doubles (their exponents line up), so the fastest gzip
+  // level already halves coordinates; higher levels gain a few percent at 1.5x the time
+  // (docs/outputs-3d.md, "Compression of the node positions").
+  void write_compressed_array(std::string_view dataset_path, const std::vector<std::size_t>& dims,
+                              const std::vector<double>& c_order, std::string_view unit,
+                              std::size_t chunk_rows);
+  // A virtual dataset of sources.size() x item_dims: entry i is the whole dataset
+  // sources[i].second of the file sources[i].first (a relative path: HDF5 looks it up beside
+  // this file, so the directory can move). Costs no data; a missing source reads as NaN.
+  void write_virtual_stack(std::string_view dataset_path, const std::vector<std::size_t>& item_dims,
+                           const std::vector<std::pair<std::string, std::string>>& sources,
+                           std::string_view unit);
+  // A second name for an existing object (an HDF5 hard link): both names read the same data.
+  void hard_link(std::string_view existing_path, std::string_view new_path);
 
   // Pushes buffered data to disk (useful before a long computation step).
   void flush();
@@ -70,11 +92,13 @@ class Hdf5File {
                    std::size_t value_count) const;
   // Opens the object (creating the group if it does not exist); returns an hid_t.
   [[nodiscard]] std::int64_t open_object(std::string_view object_path);
+  // A scalar attribute when `count` is 0, otherwise a one-dimensional one of `count` values.
   void write_attribute(std::string_view object_path, std::string_view name, std::int64_t type,
-                       const void* value);
+                       const void* value, std::size_t count = 0);
+  // `creation` is a dataset creation property list (hid_t; H5P_DEFAULT for contiguous storage).
   void write_dataset(std::string_view dataset_path, std::int64_t file_type,
                      std::int64_t memory_type, const std::vector<std::size_t>& dims,
-                     const void* data, std::string_view unit);
+                     const void* data, std::string_view unit, std::int64_t creation = 0);
 
   std::filesystem::path path_;
   std::int64_t file_ = -1;  // hid_t; kept as int64 so this header does not need hdf5.h

@@ -1,7 +1,13 @@
 #include "mresim/io/metadata.hpp"
 
+#include <unistd.h>
+
+#include <array>
 #include <ctime>
+#include <mresim/core/git_describe.hpp>
 #include <mresim/core/version.hpp>
+
+#include "mresim/app/command_line.hpp"
 
 namespace mresim::io {
 
@@ -14,9 +20,18 @@ std::string utc_timestamp() {
   return buffer;
 }
 
+std::string host_name() {
+  std::array<char, 256> buffer{};
+  if (gethostname(buffer.data(), buffer.size() - 1) != 0 || buffer[0] == '\0') return "unknown";
+  return buffer.data();
+}
+
 void write_run_metadata(Hdf5File& file, const config::TableReader& root,
                         const std::string& run_type) {
   file.write_string_attribute("/", "mresim_version", kVersion);
+  file.write_string_attribute("/", "mresim_git", kGitDescribe);
+  file.write_string_attribute("/", "host_name", host_name());
+  file.write_string_attribute("/", "command_line", app::command_line());
   file.write_string_attribute("/", "run_type", run_type);
   file.write_string_attribute("/", "input_toml", root.source_text());
   file.write_string_attribute("/", "input_file", root.source_name());

@@ -73,6 +73,27 @@ TEST(MessOutputs, ResultsSummaryAndXdmfAreConsistent) {
     const Hdf5Reader p(out / "positions" / name);
     EXPECT_EQ(p.shape("/positions"), (std::vector<hsize_t>{nodes, 3}));
   }
+  // H5MD: the particle trajectory in nm, step and time the step index, the field an observable.
+  const auto centres = h5.doubles("/steps/centres");
+  const auto position = h5.doubles("/particles/magnetic_particles/position/value");
+  ASSERT_EQ(position.size(), centres.size());
+  for (std::size_t i = 0; i < centres.size(); ++i) {
+    EXPECT_NEAR(position[i], centres[i] * 1e9, 1e-9 * std::abs(position[i]));
+  }
+  EXPECT_EQ(h5.ints("/particles/magnetic_particles/position/step"), h5.ints("/steps/index"));
+  EXPECT_EQ(h5.doubles("/observables/field/value"), h5.doubles("/steps/field"));
+  EXPECT_EQ(h5.shape("/particles/nodes/position/value"), (std::vector<hsize_t>{steps, nodes, 3}));
+  // The particle glyphs: one polyvertex grid per step, and three legs timed by the field
+  // (0 -> 0.1, 0.1 -> -0.1 turning at 0.1, -0.1 -> 0.1).
+  const std::string particles = read_text(out / "particles.xdmf");
+  EXPECT_NE(particles.find("TopologyType=\"Polyvertex\" NumberOfElements=\"2\""),
+            std::string::npos);
+  EXPECT_NE(particles.find("results.h5:/steps/magnetization"), std::string::npos);
+  EXPECT_TRUE(fs::exists(out / "xdmf" / "lattice_leg_02.xdmf"));
+  EXPECT_FALSE(fs::exists(out / "xdmf" / "lattice_leg_03.xdmf"));
+  EXPECT_NE(read_text(out / "xdmf" / "particles_leg_01.xdmf").find("<Time Value=\"-0.1\"/>"),
+            std::string::npos);
+
   // VTK hexahedron order: from vertex 0, vertex 1 is +x, vertex 3 is +y, vertex 4 is +z.
   const auto c = h5.ints("/lattice/cells");
   const auto x0 = h5.doubles("/lattice/initial_positions");

@@ -3,15 +3,16 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <numbers>
 
 #include "mresim/io/csv_writer.hpp"
 #include "mresim/mess/outputs/analysis_outputs.hpp"
+#include "mresim/mess/outputs/h5md_outputs.hpp"
 #include "mresim/mess/outputs/step_extras.hpp"
 #include "mresim/mess/outputs/step_records_io.hpp"
+#include "mresim/mess/outputs/xdmf_outputs.hpp"
 #include "mresim/mess/protocols/protocol.hpp"
 #include "mresim/mess/protocols/step_plan.hpp"
 
@@ -20,18 +21,34 @@ namespace mresim::mess_protocol {
 namespace fs = std::filesystem;
 namespace mc = mresim::mess_config;
 
+namespace {
+// Rows per chunk of a step's node positions: 32,768 x 3 doubles = 768 KiB, under HDF5's
+// default 1 MiB chunk cache, so a chunk is compressed in one piece; a lattice of up to 32,768
+// nodes is one chunk.
+constexpr std::size_t kPositionChunkRows = 32768;
+}  // namespace
+
 fs::path step_positions_file(const fs::path& run_dir, std::size_t step) {
   return run_dir / "positions" / fmt::format("step_{:06d}.h5", step);
 }
 
 void write_step_positions(const fs::path& run_dir, std::size_t step,
-                          const Eigen::Matrix3Xd& positions) {
+                          const Eigen::Matrix3Xd& positions, const Eigen::Matrix3Xd& initial) {
   const fs::path file = step_positions_file(run_dir, step);
   fs::create_directories(file.parent_path());
   const fs::path temporary = fs::path(file.string() + ".tmp");
   {
     io::Hdf5File out(temporary);
-    write_columns(out, "/positions", positions, "m");
+    // Column-major 3 x N is row-major N x 3.
+    const auto rows = static_cast<std::size_t>(positions.cols());
+    out.write_compressed_array(
+        "/positions", {rows, 3},
+        std::vector<double>(positions.data(), positions.data() + positions.size()), "m",
+        kPositionChunkRows);
+    const Eigen::Matrix3Xd u = positions - initial;
+    out.write_compressed_array("/displacement", {rows, 3},
+                               std::vector<double>(u.data(), u.data() + u.size()), "m",
+                               kPositionChunkRows);
     out.close();
   }
   fs::rename(temporary, file);
@@ -44,6 +61,23 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // VTK/XDMF hexahedron vertex order from the lattice's local order (vertex v at offset
 // ((v>>1)&1, (v>>2)&1, v&1), volume_elements.hpp): (000, 100, 110, 010, 001, 101, 111, 011).
 constexpr std::array<int, 8> kVtkOrder = {0, 2, 6, 4, 1, 3, 7, 5};
+
+// Per cell: particle k when all eight nodes belong to it (the particle's voxels, as the
+// particle_voxels figure draws them), else -1 (polymer). Unlike the node attribute particle_id,
+// which ParaView interpolates across the cells at a particle's surface, this is sharp.
+std::vector<std::int64_t> cell_material(const lattice::Lattice& lat) {
+  std::vector<std::int64_t> material;
+  material.reserve(lat.elements.size());
+  for (const auto& e : lat.elements) {
+    const std::int64_t k = lat.particle_of_node[static_cast<std::size_t>(e[0])];
+    bool all = k >= 0;
+    for (const auto node : e) {
+      all = all && lat.particle_of_node[static_cast<std::size_t>(node)] == k;
+    }
+    material.push_back(all ? k : -1);
+  }
+  return material;
+}
 
 void write_lattice(io::Hdf5File& results, const ProtocolRunner& runner) {
   const lattice::Lattice& lat = runner.system().lattice();
@@ -74,6 +108,7 @@ void write_lattice(io::Hdf5File& results, const ProtocolRunner& runner) {
     for (const int v : kVtkOrder) cells.push_back(e[static_cast<std::size_t>(v)]);
   }
   results.write_int_array("/lattice/cells", {lat.elements.size(), 8}, cells);
+  results.write_int_vector("/lattice/cell_material", cell_material(lat));
 }
 
 void write_summary(const fs::path& run_dir, const std::vector<StepRecord>& records,
@@ -110,42 +145,6 @@ void write_summary(const fs::path& run_dir, const std::vector<StepRecord>& recor
                 static_cast<double>(r.iterations), r.max_force, r.wall_time});
     csv.row(row);
   }
-}
-
-// ParaView reads the deformed lattice of every step through this XDMF 3 file.
-void write_xdmf(const fs::path& run_dir, const ProtocolRunner& runner,
-                const std::vector<StepRecord>& records) {
-  const lattice::Lattice& lat = runner.system().lattice();
-  const auto nodes = lat.node_count();
-  const auto cells = lat.cell_count();
-  std::ofstream out(run_dir / "mess.xdmf");
-  out << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n"
-      << "  <Grid Name=\"steps\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-  for (const StepRecord& r : records) {
-    const std::size_t s = r.step.index;
-    out << fmt::format("   <Grid Name=\"step_{}\" GridType=\"Uniform\">\n", s)
-        << fmt::format("    <Time Value=\"{}\"/>\n", s)
-        << fmt::format("    <Topology TopologyType=\"Hexahedron\" NumberOfElements=\"{}\">\n",
-                       cells)
-        << fmt::format(
-               "     <DataItem Dimensions=\"{} 8\" NumberType=\"Int\" Precision=\"8\" "
-               "Format=\"HDF\">results.h5:/lattice/cells</DataItem>\n",
-               cells)
-        << "    </Topology>\n    <Geometry GeometryType=\"XYZ\">\n"
-        << fmt::format(
-               "     <DataItem Dimensions=\"{} 3\" NumberType=\"Float\" Precision=\"8\" "
-               "Format=\"HDF\">positions/step_{:06d}.h5:/positions</DataItem>\n",
-               nodes, s)
-        << "    </Geometry>\n"
-        << "    <Attribute Name=\"particle_id\" AttributeType=\"Scalar\" Center=\"Node\">\n"
-        << fmt::format(
-               "     <DataItem Dimensions=\"{}\" NumberType=\"Int\" Precision=\"8\" "
-               "Format=\"HDF\">results.h5:/lattice/particle_id</DataItem>\n",
-               nodes)
-        << "    </Attribute>\n   </Grid>\n";
-  }
-  out << "  </Grid>\n </Domain>\n</Xdmf>\n";
-  if (!out) throw std::runtime_error("cannot write " + (run_dir / "mess.xdmf").string());
 }
 
 }  // namespace
@@ -266,7 +265,8 @@ MessResultCheck write_mess_results(const fs::path& run_dir, io::Hdf5File& result
   if (spec.protocol->analysis().kind != AnalysisKind::none) {
     write_analysis(run_dir, results, runner, records, x.energy_density, check);
   }
-  if (spec.output.node_positions) write_xdmf(run_dir, runner, records);
+  write_h5md(results, runner, records);
+  write_xdmf_views(run_dir, runner, records, x.field_projection);
   return check;
 }
 

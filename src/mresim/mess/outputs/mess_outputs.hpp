@@ -7,8 +7,11 @@
 //                  diagnostics), /analysis (strain and stress runs: modulus per field, MR effect)
 //   summary.csv    one row per step
 //   modulus.csv    strain and stress runs: one row per field
-//   positions/step_NNNNNN.h5 and mess.xdmf   with [output] node_positions = true: the deformed
-//                  lattice per step, for ParaView (Hexahedron cells, node attribute particle_id)
+//                  and the H5MD view of the trajectory (/h5md, /particles, /observables,
+//                  /parameters; h5md_outputs.hpp)
+//   positions/step_NNNNNN.h5   with [output] node_positions = true: the deformed lattice per
+//                  step (positions and displacements, compressed)
+//   mess.xdmf, particles.xdmf, xdmf/   the ParaView views (xdmf_outputs.hpp)
 
 #include <filesystem>
 #include <string>
@@ -20,10 +23,11 @@
 
 namespace mresim::mess_protocol {
 
-// positions/step_NNNNNN.h5 (dataset /positions, N x 3, m), written atomically.
+// positions/step_NNNNNN.h5: datasets /positions and /displacement (positions - `initial`),
+// N x 3, m, chunked and compressed (shuffle + gzip); written atomically.
 std::filesystem::path step_positions_file(const std::filesystem::path& run_dir, std::size_t step);
 void write_step_positions(const std::filesystem::path& run_dir, std::size_t step,
-                          const Eigen::Matrix3Xd& positions);
+                          const Eigen::Matrix3Xd& positions, const Eigen::Matrix3Xd& initial);
 
 // What is wrong with the results of a run (docs/outputs-3d.md, "Invalid results"):
 //  - non-finite numbers of a step (written as NaN, the step's /steps/valid = 0),

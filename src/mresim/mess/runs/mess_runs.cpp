@@ -68,7 +68,8 @@ class MessPlan final : public app::RunPlan {
     const long every = spec_.output.checkpoint_every;
     runner.run(state, [&](const ProtocolState& s) {
       if (spec_.output.node_positions) {
-        write_step_positions(staging_dir, s.records.back().step.index, runner.system().positions());
+        write_step_positions(staging_dir, s.records.back().step.index, runner.system().positions(),
+                             runner.system().lattice().positions);
       }
       if (every > 0 && s.next_step < total && s.next_step % static_cast<std::size_t>(every) == 0) {
         write_checkpoint(checkpoint, s, runner, input_toml_, input_name_);
