@@ -15,6 +15,7 @@
 #include "cli/commands.hpp"
 #include "cli/exit_status.hpp"
 #include "config_source.hpp"
+#include "mresim/app/command_line.hpp"
 #include "mresim/app/info_report.hpp"
 #include "mresim/app/run_type.hpp"
 #include "mresim/app/stop_signal.hpp"
@@ -83,6 +84,7 @@ class PythonRunPlan {
   // unless `force`) and returns `mresim run`'s exit status: 0, 3 (figures failed), 4 (invalid
   // results, written and marked) or 128 + signal (stopped; a 3D run keeps its checkpoint).
   int execute(const std::string& out, long threads, bool force, bool plot) const {
+    record_python_command_line();
     const py::gil_scoped_release computing;
     io::RunDirectory run_dir(out, io::RunDirectory::Options{force});
     const StopHandlersDuringRun stop_handlers;
@@ -90,6 +92,19 @@ class PythonRunPlan {
   }
 
  private:
+  // Provenance (results.h5 command_line): the Python interpreter and its sys.argv, since a run
+  // from Python has no mresim command line of its own.
+  static void record_python_command_line() {
+    const py::module_ sys = py::module_::import("sys");
+    std::vector<std::string> words{sys.attr("executable").cast<std::string>()};
+    for (const py::handle word : sys.attr("argv"))
+      words.push_back(py::str(word).cast<std::string>());
+    std::vector<const char*> argv;
+    argv.reserve(words.size());
+    for (const std::string& word : words) argv.push_back(word.c_str());
+    app::set_command_line(static_cast<int>(argv.size()), argv.data());
+  }
+
   config::TableReader root_;
   std::string run_type_;
   std::unique_ptr<app::RunPlan> plan_;

@@ -9,7 +9,7 @@ import mresim
 from conftest import MESS_DICT, PAIR_TOML
 
 # Differ from run to run by design: when and how long, not what.
-RUN_DEPENDENT = {"created_utc", "wall_time", "input_file"}
+RUN_DEPENDENT = {"created_utc", "wall_time", "input_file", "command_line"}
 
 
 def h5_contents(path):
