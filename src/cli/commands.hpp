@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,18 @@ namespace mresim::cli {
 // Each command registers its options on the CLI11 app and runs from the parsed values.
 // Errors propagate as exceptions; main() turns them into messages and exit statuses.
 
+// --quiet and --log FILE of run and resume (run_log.cpp; docs/cli.md#progress-and-logs).
+struct OutputOptions {
+  bool quiet = false;
+  std::optional<std::string> log;
+};
+void add_output_options(CLI::App& command, OutputOptions& options);
+// Points app::run_output() where `options` say, opening the log (truncated, or appended to when
+// `append`: a resumed run continues its log). Throws io::OutputDirectoryError (exit status 2)
+// for a log inside `out_dir` or its staging directory, or one that cannot be opened for writing.
+void configure_output(const OutputOptions& options, const std::filesystem::path& out_dir,
+                      bool append);
+
 struct RunOptions {
   std::string file;
   std::string out;    // empty: ./<run file stem>
@@ -21,6 +34,7 @@ struct RunOptions {
   bool no_plot = false;
   bool force = false;  // move an unrecognised existing --out aside instead of refusing
   std::vector<std::string> overrides;  // --set KEY=VALUE, repeatable, in order
+  OutputOptions output;
 };
 CLI::App* add_run_command(CLI::App& app, RunOptions& options);
 int run_command(const RunOptions& options);
@@ -49,6 +63,7 @@ struct ResumeOptions {
   std::string dir;
   long threads = -1;
   bool no_plot = false;
+  OutputOptions output;
 };
 CLI::App* add_resume_command(CLI::App& app, ResumeOptions& options);
 int resume_command(const ResumeOptions& options);
@@ -60,6 +75,7 @@ struct ExtendOptions {
   std::vector<std::string> overrides;  // --set KEY=VALUE: only keys that lengthen the protocol
   long threads = -1;
   bool no_plot = false;
+  OutputOptions output;
 };
 CLI::App* add_extend_command(CLI::App& app, ExtendOptions& options);
 int extend_command(const ExtendOptions& options);
@@ -70,6 +86,7 @@ struct RerunOptions {
   std::vector<std::string> overrides;  // --set solver.KEY=VALUE
   long threads = -1;
   bool no_plot = false;
+  OutputOptions output;
 };
 CLI::App* add_rerun_command(CLI::App& app, RerunOptions& options);
 int rerun_command(const RerunOptions& options);

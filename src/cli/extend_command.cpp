@@ -24,6 +24,7 @@ CLI::App* add_extend_command(CLI::App& app, ExtendOptions& options) {
   extend->add_option("DIR", options.dir, "The output directory of the finished run")->required();
   add_set_option(*extend, options.overrides);
   add_threads_option(*extend, options.threads);
+  add_output_options(*extend, options.output);
   extend->add_flag("--no-plot", options.no_plot, "Do not draw figures/*.png after the run");
   extend->footer(
       "Only keys that lengthen the protocol are accepted: field.max, field.steps, "
@@ -33,6 +34,7 @@ CLI::App* add_extend_command(CLI::App& app, ExtendOptions& options) {
 }
 
 int extend_command(const ExtendOptions& options) {
+  configure_output(options.output, options.dir, true);  // the run's log continues
   mess_protocol::check_extend_overrides(options.overrides);
   const auto computed = finished_run_file(options.dir, {}, "extend");
   const auto extended = finished_run_file(options.dir, options.overrides, "extend");

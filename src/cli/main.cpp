@@ -12,14 +12,16 @@
 #include "cli/commands.hpp"
 #include "cli/exit_status.hpp"
 #include "mresim/app/command_line.hpp"
+#include "mresim/app/run_output.hpp"
 #include "mresim/app/stop_signal.hpp"
 #include "mresim/config/config_error.hpp"
 #include "mresim/io/run_directory.hpp"
 
 namespace {
 
+// On stderr and, for run and resume with --log, in the log too.
 int report_error(const char* message, int status) {
-  std::fprintf(stderr, "mresim: error: %s\n", message);
+  mresim::app::run_output().error(std::string("mresim: error: ") + message);
   return status;
 }
 

@@ -38,6 +38,7 @@ CLI::App* add_plot_command(CLI::App& app, PlotOptions& options) {
              "u,eps_eq,green_eq,sigma_vm)");
   plot->add_flag("--animate", options.animate,
                  "3D runs: also write figures/animation.mp4 (ffmpeg) or animation.gif");
+  plot->footer("Plotting scripts: " + python_dir().string());
   return plot;
 }
 

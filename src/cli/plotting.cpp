@@ -30,10 +30,13 @@ struct ChildResult {
   int exit_status = 0;
 };
 
+// What of a child's output reaches mresim's stdout and stderr.
+enum class ChildOutput { shown, errors_only, hidden };
+
 // Runs a program found on PATH, with matplotlib's non-interactive backend unless the user chose
-// one (figures are files; no display is needed or wanted). Quiet children have their output
-// sent to /dev/null.
-ChildResult spawn_and_wait(const std::vector<std::string>& args, bool quiet) {
+// one (figures are files; no display is needed or wanted). What the child's output does not
+// show goes to /dev/null.
+ChildResult spawn_and_wait(const std::vector<std::string>& args, ChildOutput shown) {
   std::vector<char*> argv;
   argv.reserve(args.size() + 1);
   for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
@@ -49,8 +52,10 @@ ChildResult spawn_and_wait(const std::vector<std::string>& args, bool quiet) {
 
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
-  if (quiet) {
+  if (shown != ChildOutput::shown) {
     posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  }
+  if (shown == ChildOutput::hidden) {
     posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
   }
   pid_t pid = 0;
@@ -69,10 +74,23 @@ ChildResult spawn_and_wait(const std::vector<std::string>& args, bool quiet) {
 
 }  // namespace
 
+std::filesystem::path installed_python_dir() {
+  // An installed mresim (cmake --install) lies in <prefix>/bin, its scripts in
+  // <prefix>/share/mresim/python: found through the executable, wherever the prefix was moved.
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) return {};
+  const std::filesystem::path dir =
+      exe.parent_path().parent_path() / MRESIM_INSTALL_PYTHON_SCRIPTS_DIR;
+  return std::filesystem::is_regular_file(dir / "mresim_plot.py", ec) ? dir
+                                                                      : std::filesystem::path();
+}
+
 std::filesystem::path python_dir() {
   const char* from_env = std::getenv("MRESIM_PYTHON_DIR");
   if (from_env != nullptr && *from_env != '\0') return from_env;
-  return MRESIM_PYTHON_DIR;
+  if (auto installed = installed_python_dir(); !installed.empty()) return installed;
+  return MRESIM_PYTHON_DIR;  // the source tree's, for the build tree's mresim
 }
 
 std::string python_interpreter() {
@@ -86,7 +104,8 @@ namespace {
 constexpr const char* kSystemPython = "/usr/bin/python3";
 
 bool has_plot_modules(const std::string& python) {
-  const ChildResult r = spawn_and_wait({python, "-c", "import matplotlib, numpy, h5py"}, true);
+  const ChildResult r =
+      spawn_and_wait({python, "-c", "import matplotlib, numpy, h5py"}, ChildOutput::hidden);
   return r.started && r.exit_status == 0;
 }
 
@@ -103,7 +122,7 @@ std::string plotting_interpreter(int& failure_status) {
       has_plot_modules(kSystemPython)) {
     return kSystemPython;
   }
-  const ChildResult found = spawn_and_wait({python, "-c", "pass"}, true);
+  const ChildResult found = spawn_and_wait({python, "-c", "pass"}, ChildOutput::hidden);
   failure_status = found.started ? 1 : 127;
   if (!found.started) {
     std::fprintf(stderr, "mresim: error: %s was not found; %s\n", python.c_str(), kInstallHint);
@@ -119,8 +138,8 @@ std::string plotting_interpreter(int& failure_status) {
 
 }  // namespace
 
-int draw_figures(const std::filesystem::path& run_dir,
-                 const std::vector<std::string>& script_args) {
+int draw_figures(const std::filesystem::path& run_dir, const std::vector<std::string>& script_args,
+                 bool quiet) {
   const auto script = python_dir() / "mresim_plot.py";
   if (!std::filesystem::is_regular_file(script)) {
     throw std::runtime_error(fmt::format(
@@ -133,7 +152,8 @@ int draw_figures(const std::filesystem::path& run_dir,
   const auto started = std::filesystem::file_time_type::clock::now();
   std::vector<std::string> args = {python, script.string(), run_dir.string()};
   args.insert(args.end(), script_args.begin(), script_args.end());
-  const ChildResult plot = spawn_and_wait(args, false);
+  const ChildResult plot =
+      spawn_and_wait(args, quiet ? ChildOutput::errors_only : ChildOutput::shown);
   // The figures are mresim's files: list them in the run's manifest, so that a later run may
   // replace the directory. Only what this plot wrote, never a file the user put there.
   io::run_manifest::add_files_below(run_dir, "figures", started);

@@ -24,6 +24,7 @@ CLI::App* add_rerun_command(CLI::App& app, RerunOptions& options) {
       ->check(CLI::NonNegativeNumber);
   add_set_option(*rerun, options.overrides);
   add_threads_option(*rerun, options.threads);
+  add_output_options(*rerun, options.output);
   rerun->add_flag("--no-plot", options.no_plot, "Do not draw figures/*.png after the run");
   rerun->footer(
       "Only solver settings may change (solver.*). The step starts from the state before it; "
@@ -33,6 +34,7 @@ CLI::App* add_rerun_command(CLI::App& app, RerunOptions& options) {
 }
 
 int rerun_command(const RerunOptions& options) {
+  configure_output(options.output, options.dir, true);  // the run's log continues
   mess_protocol::check_rerun_overrides(options.overrides);
   const auto computed = finished_run_file(options.dir, {}, "rerun");
   const auto rerun = finished_run_file(options.dir, options.overrides, "rerun");

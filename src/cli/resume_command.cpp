@@ -13,6 +13,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/exit_status.hpp"
+#include "mresim/app/run_output.hpp"
 #include "mresim/io/hdf5_reader.hpp"
 #include "mresim/io/run_directory.hpp"
 #include "mresim/mess/outputs/checkpoint.hpp"
@@ -27,6 +28,7 @@ CLI::App* add_resume_command(CLI::App& app, ResumeOptions& options) {
   resume->add_option("DIR", options.dir, "The output directory the interrupted run was writing")
       ->required();
   add_threads_option(*resume, options.threads);
+  add_output_options(*resume, options.output);
   resume->add_flag("--no-plot", options.no_plot, "Do not draw figures/*.png after the run");
   resume->footer(
       "An interrupted run (killed, or stopped by SIGINT/SIGTERM) leaves DIR.partial-<pid>/ next "
@@ -54,15 +56,15 @@ config::TableReader read_with_overrides_record(const fs::path& dir,
       }
     } catch (const std::exception&) {  // unreadable: resume without it, say so below
     }
-    std::fprintf(stderr,
-                 "mresim: warning: %s does not match the checkpoint; the results will record "
-                 "the effective run file only, without input_overrides and input_file_toml\n",
-                 file.string().c_str());
+    app::warn(file.string() +
+              " does not match the checkpoint; the results will record the effective run file "
+              "only, without input_overrides and input_file_toml");
   }
   return config::TableReader::parse_string(effective_text, name);
 }
 
 int resume_command(const ResumeOptions& options) {
+  configure_output(options.output, options.dir, true);  // a resumed run continues its log
   const fs::path checkpoint_name = mess_protocol::kCheckpointFile;
   // Locks DIR first: while a run or another resume holds it, nothing is taken over.
   const auto run_dir = io::RunDirectory::resume(options.dir, checkpoint_name);
@@ -78,8 +80,10 @@ int resume_command(const ResumeOptions& options) {
   const auto root = read_with_overrides_record(run_dir->path(), text, name);
   std::string run_type;
   const auto plan = app::make_plan(root, &run_type);
-  std::printf("mresim: resuming the run in %s\n", run_dir->path().string().c_str());
-  std::fflush(stdout);
+  if (!app::run_output().quiet()) {
+    std::printf("mresim: resuming the run in %s\n", run_dir->path().string().c_str());
+    std::fflush(stdout);
+  }
   return execute_and_publish(root, *plan, run_type, *run_dir, options.threads, options.no_plot);
 }
 

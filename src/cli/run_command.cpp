@@ -15,6 +15,7 @@
 #include "cli/exit_status.hpp"
 #include "cli/plotting.hpp"
 #include "mresim/app/invalid_results.hpp"
+#include "mresim/app/run_output.hpp"
 #include "mresim/app/run_type.hpp"
 #include "mresim/app/stop_signal.hpp"
 #include "mresim/app/threads.hpp"
@@ -37,6 +38,7 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& options) {
                   "existing directory is refused");
   add_threads_option(*run, options.threads);
   add_set_option(*run, options.overrides);
+  add_output_options(*run, options.output);
   run->add_flag("--no-plot", options.no_plot, "Do not draw figures/*.png after the run");
   run->add_flag("--force", options.force,
                 "Use --out even if it holds files mresim did not write: the old directory is "
@@ -46,6 +48,10 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& options) {
 }
 
 int run_command(const RunOptions& options) {
+  const fs::path out = options.out.empty() ? fs::path(options.file).stem() : fs::path(options.out);
+  // 0. Messages: stderr unless --quiet, and the --log file, from the first line on.
+  configure_output(options.output, out, false);
+
   // 1. Parse and validate the whole run file, unknown keys included, before touching the disk.
   // --set overrides are applied to the parsed file first, so they are validated as the file is.
   const auto root = config::TableReader::parse_file(options.file, options.overrides);
@@ -53,7 +59,6 @@ int run_command(const RunOptions& options) {
   const auto plan = app::make_plan(root, &run_type);
 
   // 2. Claim the output directory (refused if it holds something other than an mresim run).
-  const fs::path out = options.out.empty() ? fs::path(options.file).stem() : fs::path(options.out);
   io::RunDirectory run_dir(out, io::RunDirectory::Options{options.force});
 
   return execute_and_publish(root, *plan, run_type, run_dir, options.threads, options.no_plot);
@@ -66,16 +71,14 @@ int report_interrupted(const app::Interrupted& e, io::RunDirectory& run_dir) {
   const std::string shown = run_dir.shown_path().string();
   if (e.resumable) {
     run_dir.keep_for_resume();
-    std::fprintf(stderr,
-                 "mresim: interrupted by %s %s; the checkpoint is in '%s'; continue with "
-                 "'mresim resume %s'\n",
-                 app::signal_name(e.signal).c_str(), e.what(), run_dir.path().string().c_str(),
-                 shown.c_str());
+    app::run_output().error(fmt::format(
+        "mresim: interrupted by {} {}; the checkpoint is in '{}'; continue with 'mresim resume {}'",
+        app::signal_name(e.signal), e.what(), run_dir.path().string(), shown));
   } else {
-    std::fprintf(stderr,
-                 "mresim: interrupted by %s %s; this run type writes no checkpoints, nothing was "
-                 "written to '%s'\n",
-                 app::signal_name(e.signal).c_str(), e.what(), shown.c_str());
+    app::run_output().error(
+        fmt::format("mresim: interrupted by {} {}; this run type writes no checkpoints, nothing "
+                    "was written to '{}'",
+                    app::signal_name(e.signal), e.what(), shown));
   }
   return 128 + e.signal;
 }
@@ -167,24 +170,27 @@ int execute_and_publish(const config::TableReader& root, const app::RunPlan& pla
 
   // 4. Publish the complete directory in one step.
   run_dir.commit();
-  std::printf("mresim: results written to %s\n", out.string().c_str());
-  if (!run_dir.moved_aside().empty()) {
-    std::printf("mresim: the directory that was there (--force) is now %s\n",
-                run_dir.moved_aside().string().c_str());
+  const bool quiet = app::run_output().quiet();
+  if (!quiet) {
+    std::printf("mresim: results written to %s\n", out.string().c_str());
+    if (!run_dir.moved_aside().empty()) {
+      std::printf("mresim: the directory that was there (--force) is now %s\n",
+                  run_dir.moved_aside().string().c_str());
+    }
+    std::fflush(stdout);
   }
-  std::fflush(stdout);
-  const int plot_status = no_plot ? kSuccess : draw_figures(run_dir.final_path());
+  const int plot_status = no_plot ? kSuccess : draw_figures(run_dir.final_path(), {}, quiet);
   if (plot_status != kSuccess) {
-    std::fprintf(stderr,
-                 "mresim: error: drawing the figures failed; the results are complete in '%s' "
-                 "(retry with 'mresim plot %s')\n",
-                 out.string().c_str(), out.string().c_str());
+    app::run_output().error(
+        fmt::format("mresim: error: drawing the figures failed; the results are complete in '{}' "
+                    "(retry with 'mresim plot {}')",
+                    out.string(), out.string()));
   }
   if (!invalid_results.empty()) {
-    std::fprintf(stderr,
-                 "mresim: error: %s; the results in '%s' are kept with these entries marked "
-                 "invalid\n",
-                 invalid_results.c_str(), out.string().c_str());
+    app::run_output().error(
+        fmt::format("mresim: error: {}; the results in '{}' are kept with these entries marked "
+                    "invalid",
+                    invalid_results, out.string()));
     return kInvalidResults;
   }
   return plot_status == kSuccess ? kSuccess : kPlotFailed;

@@ -4,12 +4,12 @@
 
 #include <cmath>
 #include <cstdint>
-#include <iostream>
 #include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "mresim/app/run_output.hpp"
 #include "mresim/io/csv_writer.hpp"
 #include "mresim/magnetism/loop_features.hpp"
 
@@ -36,10 +36,10 @@ LoopFeatures features_or_nan(const MagnetizationCurve& curve, bool curve_finite)
     // A loop that never switches legitimately has no B_c or M_r; a loop with non-finite
     // points is flagged by write_curve instead (no warning: it is an error there).
     if (!curve_finite) return nan_features();
-    std::cerr << fmt::format(
-        "mresim: warning: no coercive field or remanence ({}); written as "
-        "NaN. Is field.max beyond the switching fields?\n",
-        e.what());
+    app::warn(
+        fmt::format("no coercive field or remanence ({}); written as NaN. Is field.max beyond the "
+                    "switching fields?",
+                    e.what()));
   }
   return nan_features();
 }

@@ -105,6 +105,7 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
     }
     options.force_tolerance = spec_.solver.minimiser.force_tolerance;
     options.max_iterations = static_cast<int>(spec_.solver.minimiser.max_iterations);
+    options.observer = observer_;
     const mess::MinimiserResult r = mess::minimise(system_, options);
     record.converged = r.converged;
     record.status = to_string(r.status);
@@ -118,6 +119,7 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
     options.steps_per_round = static_cast<int>(spec_.solver.leapfrog.steps_per_round);
     options.max_rounds = static_cast<int>(spec_.solver.leapfrog.max_rounds);
     options.drag = spec_.solver.leapfrog.drag;
+    options.observer = observer_;
     // docs/original-code.md#convergence: at zero field and zero load one round may end the step.
     options.first_round_may_end = b < 1e-12 && step.load_value == 0.0;
     const mess::LeapfrogResult r = mess::relax_leapfrog(system_, options);

@@ -22,11 +22,13 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mresim/mess/protocols/step_plan.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
 #include "mresim/mess/solvers/newton.hpp"
+#include "mresim/mess/solvers/relaxation_observer.hpp"
 #include "mresim/mess/system/system_energy.hpp"
 
 namespace mresim::mess_protocol {
@@ -88,6 +90,12 @@ class ProtocolRunner {
   // Runs the remaining steps; after each one calls after_step(state) (checkpoints, progress).
   void run(ProtocolState& state, const std::function<void(const ProtocolState&)>& after_step);
 
+  // Shown the iterations of every relaxation from now on (progress reports; relaxation_observer
+  // .hpp). Changes nothing the steps compute.
+  void set_relaxation_observer(mess::RelaxationObserver observer) {
+    observer_ = std::move(observer);
+  }
+
  private:
   std::size_t slot_of_field(std::size_t field_index) const;
   const SlotState* start_state(const StepSpec& step, const ProtocolState& state) const;
@@ -97,6 +105,7 @@ class ProtocolRunner {
   mess::MessSystem system_;
   // solver.method = "newton": the multigrid, built at the first step and kept for the others.
   std::shared_ptr<mess::NewtonCache> newton_cache_ = std::make_shared<mess::NewtonCache>();
+  mess::RelaxationObserver observer_;
 };
 
 // Sum of the cell volumes (m^3) at positions x.

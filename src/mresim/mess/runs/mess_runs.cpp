@@ -11,20 +11,22 @@
 #include <fmt/format.h>
 
 #include <filesystem>
-#include <iostream>
 #include <memory>
 #include <string>
 
 #include "mresim/app/invalid_results.hpp"
+#include "mresim/app/run_output.hpp"
 #include "mresim/app/run_type.hpp"
 #include "mresim/app/stop_signal.hpp"
 #include "mresim/mess/outputs/checkpoint.hpp"
 #include "mresim/mess/outputs/mess_outputs.hpp"
 #include "mresim/mess/protocols/protocol_runner.hpp"
+#include "mresim/mess/protocols/step_plan.hpp"
 #include "mresim/mess/restart/run_history.hpp"
 #include "mresim/mess/restart/saved_run.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
 #include "mresim/mess/solvers/amg_preconditioner.hpp"
+#include "mresim/mess/solvers/relaxation_observer.hpp"
 #include "mresim/pair/runs/pair_outputs.hpp"
 
 namespace mresim::mess_protocol {
@@ -53,44 +55,53 @@ class MessPlan final : public app::RunPlan {
     // Read-time warnings: printed here, not in the constructor, so that `info` (which lists
     // them) and a run file refused later by make_plan print only their own lines.
     pair::runs::print_warnings(spec_.warnings);
+    progress.note(setup_line());
     ProtocolRunner runner(spec_);
     const fs::path checkpoint = staging_dir / kCheckpointFile;
     ProtocolState state = fs::exists(checkpoint) ? read_checkpoint(checkpoint, runner, input_toml_)
                                                  : runner.initial_state();
     const std::size_t total = runner.steps().size();
     if (state.next_step > 0) {
-      std::cerr << fmt::format("mresim: resuming at step {} of {} from the checkpoint\n",
-                               state.next_step, total);
+      progress.note(fmt::format("mresim: resuming at step {} of {} from the checkpoint",
+                                state.next_step, total));
     }
     progress.set_total(total);
-    progress.advance(state.next_step);
+    progress.skip(state.next_step);
+    const bool leapfrog = spec_.solver.method == mc::SolverMethod::leapfrog;
+    progress.set_residual(leapfrog ? "mean |a|" : "max force", leapfrog ? "l_e/t_c^2" : "N");
+    runner.set_relaxation_observer([&progress](const mess::RelaxationIteration& it) {
+      progress.iteration(it.iteration, it.residual);
+    });
 
     const long every = spec_.output.checkpoint_every;
-    runner.run(state, [&](const ProtocolState& s) {
+    while (state.next_step < total) {
+      progress.begin_step(step_description(runner.steps()[state.next_step]));
+      const StepRecord& record = runner.run_next_step(state);
+      progress.end_step({record.iterations, record.max_force, record.converged, record.wall_time});
       if (spec_.output.node_positions) {
-        write_step_positions(staging_dir, s.records.back().step.index, runner.system().positions(),
+        write_step_positions(staging_dir, record.step.index, runner.system().positions(),
                              runner.system().lattice().positions);
       }
-      if (every > 0 && s.next_step < total && s.next_step % static_cast<std::size_t>(every) == 0) {
-        write_checkpoint(checkpoint, s, runner, input_toml_, input_name_);
+      if (every > 0 && state.next_step < total &&
+          state.next_step % static_cast<std::size_t>(every) == 0) {
+        write_checkpoint(checkpoint, state, runner, input_toml_, input_name_);
       }
-      progress.advance();
       // SIGINT/SIGTERM: a step boundary is the safe point; checkpoint (whatever checkpoint_every
       // says) so that `mresim resume` continues from here.
-      if (app::stop_requested() && s.next_step < total) {
-        write_checkpoint(checkpoint, s, runner, input_toml_, input_name_);
+      if (app::stop_requested() && state.next_step < total) {
+        write_checkpoint(checkpoint, state, runner, input_toml_, input_name_);
         throw app::Interrupted(app::stop_signal(), true,
-                               fmt::format("after step {} of {}", s.next_step, total));
+                               fmt::format("after step {} of {}", state.next_step, total));
       }
-    });
+    }
 
     const MessResultCheck check = write_mess_results(staging_dir, results, runner, state.records);
     publish_pending_history(staging_dir, results, runner);          // an extended run's /history
     pair::runs::write_warnings_attribute(results, spec_.warnings);  // /@warnings, as pair runs
     warn_about_intermediate_solves(state.records);
     for (const std::string& fit : check.invalid_fits) {
-      std::cerr << "mresim: warning: invalid modulus fit, not a result: " << fit
-                << " (marked in /analysis/valid and modulus.csv)\n";
+      app::warn("invalid modulus fit, not a result: " + fit +
+                " (marked in /analysis/valid and modulus.csv)");
     }
     // The state after the last step stays with the results, for `mresim extend` and `rerun`
     // (restart/saved_run.hpp); the checkpoint is not needed any more.
@@ -105,6 +116,39 @@ class MessPlan final : public app::RunPlan {
   }
 
  private:
+  // "mresim: lattice 42 x 42 x 83 nodes (146412 nodes, 5 particles), 21 steps, solver lbfgs,
+  // memory estimate 230.1 MiB (available 100.0 GiB, MemAvailable)".
+  std::string setup_line() const {
+    const auto& g = spec_.geometry;
+    const mc::AvailableMemory available = mc::available_memory();
+    const auto gib = [](std::int64_t bytes) {
+      return bytes >= (std::int64_t{1} << 30)
+                 ? fmt::format("{:.1f} GiB", static_cast<double>(bytes) / (1 << 30))
+                 : fmt::format("{:.1f} MiB", static_cast<double>(bytes) / (1 << 20));
+    };
+    const char* method = spec_.solver.method == mc::SolverMethod::newton     ? "newton"
+                         : spec_.solver.method == mc::SolverMethod::leapfrog ? "leapfrog"
+                                                                             : "lbfgs";
+    std::string line = fmt::format(
+        "mresim: lattice {} x {} x {} nodes ({} nodes, {} particles), {} steps, solver {}, "
+        "memory estimate {}",
+        g.shape.nx(), g.shape.ny(), g.shape.nz(), g.node_count(), g.particle_count(),
+        plan_steps(spec_).size(), method, gib(mc::estimated_memory_bytes(spec_)));
+    if (available.bytes)
+      line += fmt::format(" (available {}, {})", gib(*available.bytes), available.source);
+    return line;
+  }
+
+  // "B 0.100 T" (along the run's field direction), with ", strain 0.01" for loaded protocols.
+  std::string step_description(const StepSpec& step) const {
+    std::string what = fmt::format("B {:.4g} T", step.field.dot(field_direction(spec_)));
+    if (spec_.load_step_count() > 1) {
+      const std::string unit = load_unit(spec_);
+      what += fmt::format(", load {:.4g}{}", step.load_value, unit == "1" ? "" : " " + unit);
+    }
+    return what;
+  }
+
   // A magnetization solve that missed its tolerance during a step whose final solve converged
   // leaves a valid step; it is reported, not an error.
   static void warn_about_intermediate_solves(const std::vector<StepRecord>& records) {
@@ -113,10 +157,10 @@ class MessPlan final : public app::RunPlan {
       if (r.unconverged_magnetization_solves > 0) ++magnetization;
     }
     if (magnetization > 0) {
-      std::cerr << fmt::format(
-          "mresim: warning: in {} of {} steps some magnetization solve missed its tolerance "
-          "(see /steps/solver/unconverged_magnetization_solves)\n",
-          magnetization, records.size());
+      app::warn(
+          fmt::format("in {} of {} steps some magnetization solve missed its tolerance "
+                      "(see /steps/solver/unconverged_magnetization_solves)",
+                      magnetization, records.size()));
     }
   }
 

@@ -189,6 +189,7 @@ LeapfrogResult relax_leapfrog(MessSystem& system, const LeapfrogOptions& options
       if (res.steps % options.difference_interval == 0) {
         difference_norms.push_back((x - sample).norm() / l_e);
         sample = x;
+        if (options.observer) options.observer({res.steps, acc.main_mean(a)});
       }
     }
     ++res.rounds;

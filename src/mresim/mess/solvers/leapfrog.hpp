@@ -40,6 +40,7 @@
 #include <string>
 #include <vector>
 
+#include "mresim/mess/solvers/relaxation_observer.hpp"
 #include "mresim/mess/system/system_energy.hpp"
 
 namespace mresim::mess {
@@ -73,6 +74,9 @@ struct LeapfrogOptions {
   bool first_round_may_end = false;
   bool extend_for_moving_particles = true;
   RigidGroupRule rigid_group_rule = RigidGroupRule::total_force;  // the profile decides
+  // Told the time steps and the mean |a| every difference_interval steps (progress reports);
+  // changes nothing.
+  RelaxationObserver observer;
 
   void validate() const;  // throws std::invalid_argument naming the option
 };

@@ -401,10 +401,13 @@ class Minimisation {
     return measure_.max_force(f_.full_gradient()) <= opt_.force_tolerance * force_scale_;
   }
 
-  bool converged(double energy_change) const {
+  // The inner minimisations' convergence test; also what the observer is shown.
+  bool converged(double energy_change) {
+    const double max_force = measure_.max_force(f_.full_gradient());
+    if (opt_.observer) opt_.observer({++convergence_checks_, max_force});
     // Energy change relative to the potential's size, but never below the energy scale E0:
     // tiny energies (a block at 1e-4 strain) are dominated by their own rounding noise.
-    return forces_below_tolerance() &&
+    return max_force <= opt_.force_tolerance * force_scale_ &&
            std::abs(energy_change) <= opt_.energy_tolerance * std::max(f_.magnitude(), 1.0);
   }
 
@@ -505,6 +508,7 @@ class Minimisation {
   MinimiserMethod method_;
   bool use_energy_ = true;
   bool conservative_phase_ = false;
+  std::int64_t convergence_checks_ = 0;
 };
 
 }  // namespace

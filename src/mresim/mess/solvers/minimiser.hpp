@@ -57,6 +57,7 @@
 #include <string>
 
 #include "mresim/mess/solvers/amg_preconditioner.hpp"
+#include "mresim/mess/solvers/relaxation_observer.hpp"
 #include "mresim/mess/system/system_energy.hpp"
 
 namespace mresim::mess {
@@ -113,6 +114,8 @@ struct MinimiserOptions {
   // newton: where the multigrid is kept between calls (a caller relaxing many steps of one
   // run keeps one; null: built anew in every call).
   std::shared_ptr<NewtonCache> newton_cache;
+  // Told every convergence check's largest force (progress reports); changes nothing.
+  RelaxationObserver observer;
 
   void validate() const;  // throws std::invalid_argument naming the option
 };

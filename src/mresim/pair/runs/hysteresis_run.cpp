@@ -2,9 +2,9 @@
 // 3.4, 3.13), each with its critical fields.
 #include <fmt/format.h>
 
-#include <iostream>
 #include <memory>
 
+#include "mresim/app/run_output.hpp"
 #include "mresim/app/run_type.hpp"
 #include "mresim/core/parallel_exceptions.hpp"
 #include "mresim/pair/runs/pair_outputs.hpp"
@@ -75,10 +75,10 @@ class HysteresisPlan final : public app::RunPlan {
                           fields[c].hc1, fields[c].hc2, fields[c].delta(), fields[c].uncertainty,
                           fields[c].valid() ? 1.0 : 0.0});
       if (const std::size_t bad = unconverged_states(loops[c]); bad > 0) {
-        std::cerr << fmt::format(
-            "mresim: warning: case {} ({}): {} of {} states did not reach "
-            "the relaxation tolerance (see solver/converged)\n",
-            c, cases_[c].label, bad, loops[c].states.size());
+        app::warn(
+            fmt::format("case {} ({}): {} of {} states did not reach the relaxation tolerance (see "
+                        "solver/converged)",
+                        c, cases_[c].label, bad, loops[c].states.size()));
       }
     }
     results.write_int_attribute("/cases", "count", static_cast<std::int64_t>(cases_.size()));

@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iostream>
 
+#include "mresim/app/run_output.hpp"
 #include "mresim/pair/overlap_penalty.hpp"
 #include "mresim/pair/stiffness.hpp"
 
@@ -148,7 +148,7 @@ void check_critical_fields(app::ResultCheck& check, const std::string& where,
 }
 
 void print_warnings(const std::vector<std::string>& warnings) {
-  for (const std::string& w : warnings) std::cerr << "mresim: warning: " << w << '\n';
+  for (const std::string& w : warnings) app::warn(w);
 }
 
 void write_warnings_attribute(io::Hdf5File& h5, const std::vector<std::string>& warnings) {
