@@ -118,7 +118,8 @@ class RerunPlan final : public app::RunPlan {
         carry_kept_file(kept, step_positions_file(staging_dir, k));
     }
     if (computed_spec_.output.node_positions) {
-      write_step_positions(staging_dir, step_, rerunner.system().positions());
+      write_step_positions(staging_dir, step_, rerunner.system().positions(),
+                           rerunner.system().lattice().positions);
     }
     if (saved.has_final_state) {
       write_checkpoint(staging_dir / kFinalStateFile,
