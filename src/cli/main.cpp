@@ -41,10 +41,14 @@ int run_cli(int argc, char** argv) {
   InfoOptions info_options;
   PlotOptions plot_options;
   ResumeOptions resume_options;
+  SweepOptions sweep_options;
+  CollectOptions collect_options;
   CLI::App* run = add_run_command(app, run_options);
   CLI::App* resume = add_resume_command(app, resume_options);
   CLI::App* info = add_info_command(app, info_options);
   CLI::App* plot = add_plot_command(app, plot_options);
+  CLI::App* sweep = add_sweep_command(app, sweep_options);
+  CLI::App* collect = add_collect_command(app, collect_options);
   CLI::App* types = add_types_command(app);
 
   // CLI11 would take an unknown command for a stray argument and, with --help, print the main
@@ -79,11 +83,13 @@ int run_cli(int argc, char** argv) {
   }
 
   try {
-    if (*run || *resume) mresim::app::install_stop_handlers();
+    if (*run || *resume || *sweep) mresim::app::install_stop_handlers();
     if (*run) return run_command(run_options);
     if (*resume) return resume_command(resume_options);
     if (*info) return info_command(info_options);
     if (*plot) return plot_command(plot_options);
+    if (*sweep) return sweep_command(sweep_options);
+    if (*collect) return collect_command(collect_options);
     if (*types) return types_command();
   } catch (const mresim::config::ConfigError& e) {
     return report_error(e.what(), kInvalidInput);
