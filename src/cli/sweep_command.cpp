@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <thread>
 #include <vector>
@@ -162,6 +163,21 @@ int report(const sweep::SweepSpec& spec, const std::vector<int>& outcome,
   return failed == 0 && not_started == 0 ? kSuccess : kFailure;
 }
 
+// An integer option in [min, max]: "VALUE: must be an integer from MIN to MAX (WHAT)".
+CLI::Validator integer_between(long min, long max, const char* what) {
+  return CLI::Validator(
+      [=](std::string& value) -> std::string {
+        try {
+          std::size_t used = 0;
+          const long n = std::stol(value, &used);
+          if (used == value.size() && n >= min && n <= max) return "";
+        } catch (const std::exception&) {  // not a number, or out of long's range
+        }
+        return fmt::format("{}: must be an integer from {} to {} ({})", value, min, max, what);
+      },
+      "INT", what);
+}
+
 }  // namespace
 
 CLI::App* add_sweep_command(CLI::App& app, SweepOptions& options) {
@@ -174,12 +190,12 @@ CLI::App* add_sweep_command(CLI::App& app, SweepOptions& options) {
                     "Sweep directory (default: ./<FILE without extension>); points go to "
                     "DIR/point-NNNN/, finished ones are skipped when run again");
   sweep->add_option("--jobs", options.jobs, "Points run at once on this machine (default 1)")
-      ->check(CLI::Range(1L, 1024L));
+      ->check(integer_between(1, 1024, "points at once"));
   add_threads_option(*sweep, options.threads);
   sweep
       ->add_option("--index", options.index,
                    "Run only point I (0-based), e.g. $SLURM_ARRAY_TASK_ID; no collect")
-      ->check(CLI::NonNegativeNumber);
+      ->check(integer_between(0, std::numeric_limits<int>::max(), "a point number"));
   return sweep;
 }
 

@@ -168,7 +168,7 @@ SweepSpec expand_sweep(const toml::table& root) {
   for (const Axis& a : zip) {
     if (a.values->size() != zip.front().values->size()) {
       throw ConfigError(fmt::format(
-          "sweep.zip: the lists must have one length: \"{}\" has {} value(s), \"{}\" has {}",
+          R"(sweep.zip: the lists must have one length: "{}" has {} value(s), "{}" has {})",
           zip.front().key, zip.front().values->size(), a.key, a.values->size()));
     }
   }
