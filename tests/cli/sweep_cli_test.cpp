@@ -173,8 +173,8 @@ TEST(CliSweep, AnIndexPastTheLastPointIsRefusedAndNothingIsWritten) {
 // mpirun -np 2: each rank runs every second point, rank 0 collects; the tables equal those of
 // a sweep in one process.
 TEST(CliSweep, TwoMpiRanksCollectTheSameTablesAsOneProcess) {
-  const fs::path mpirun = "/usr/bin/mpirun";
-  if (!present(mpirun)) GTEST_SKIP() << "no " << mpirun;
+  const fs::path mpirun = MRESIM_MPIEXEC;  // CMake's MPIEXEC_EXECUTABLE
+  if (mpirun.empty() || !present(mpirun)) GTEST_SKIP() << "no MPI launcher (mpirun) found";
   const TempDir dir;
   write_text(dir / "s.toml", kSweep);
   const Result serial = mresim(dir.path(), {"sweep", "s.toml", "--out", "serial"});
