@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <limits>
 #include <string>
@@ -35,7 +36,10 @@ namespace fs = std::filesystem;
 namespace {
 
 // What became of one point in this invocation; summed over the ranks (0: not this rank's).
-enum Outcome : int { kNotMine = 0, kSkipped = 1, kNotStarted = 2, kExitBase = 3 };
+constexpr int kNotMine = 0;
+constexpr int kSkipped = 1;     // already finished
+constexpr int kNotStarted = 2;  // a stop signal came first
+constexpr int kExitBase = 3;    // ran: kExitBase + its exit status
 
 std::string parameters_text(const sweep::SweepPoint& point) {
   return fmt::format("{}", fmt::join(point.overrides, ", "));
@@ -112,9 +116,10 @@ std::vector<int> run_points(const sweep::SweepSpec& spec, const std::vector<std:
                             const fs::path& dir, long jobs, long threads) {
   std::vector<int> outcome(spec.points.size(), kNotMine);
   const auto n = static_cast<long>(mine.size());
+  const auto at_once = static_cast<int>(jobs);
   // OpenMP's dynamic schedule hands the next point to whichever job finishes first; each
   // iteration only starts a child process and waits for it.
-#pragma omp parallel for schedule(dynamic, 1) num_threads(static_cast <int>(jobs))
+#pragma omp parallel for schedule(dynamic, 1) num_threads(at_once)
   for (long k = 0; k < n; ++k) {
     const sweep::SweepPoint& point = spec.points[mine[static_cast<std::size_t>(k)]];
     const std::size_t count = spec.points.size();
@@ -123,7 +128,15 @@ std::vector<int> run_points(const sweep::SweepSpec& spec, const std::vector<std:
     } else if (app::stop_requested()) {
       outcome[point.index] = kNotStarted;
     } else {
-      outcome[point.index] = kExitBase + run_point(spec, point, dir, threads);
+      // Nothing may leave an OpenMP iteration, and under MPI every rank must reach the final
+      // reduction: a failure of the bookkeeping (a log or status file that cannot be written)
+      // counts as a failure of the point.
+      try {
+        outcome[point.index] = kExitBase + run_point(spec, point, dir, threads);
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "mresim: error: sweep point %zu: %s\n", point.index, e.what());
+        outcome[point.index] = kExitBase + kFailure;
+      }
     }
   }
   return outcome;
@@ -245,8 +258,9 @@ int sweep_command(const SweepOptions& options) {
   const int status = report(spec, outcome, chosen, dir);
   if (options.index < 0) {
     const sweep::CollectResult collected = sweep::collect(dir);
-    std::printf("mresim sweep: collected tables: %s\n", (dir / "collected.h5").string().c_str());
-    (void)collected;
+    std::printf("mresim sweep: collected tables of %zu finished point(s): %s/collected_*.csv, %s\n",
+                collected.finished, dir.string().c_str(),
+                collected.written.back().string().c_str());
   }
   return status;
 }
