@@ -6,6 +6,8 @@
 #define MPICH_SKIP_MPICXX 1  // NOLINT(cppcoreguidelines-macro-usage)
 #include <mpi.h>
 
+#include <algorithm>
+#include <array>
 #include <cstdlib>
 #include <string>
 
@@ -14,10 +16,10 @@ namespace mresim::cli {
 namespace {
 
 bool started_by_mpi_launcher() {
-  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_SIZE"}) {
-    if (std::getenv(name) != nullptr) return true;
-  }
-  return false;
+  constexpr std::array<const char*, 3> kLaunchVariables = {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK",
+                                                           "PMI_SIZE"};
+  return std::ranges::any_of(kLaunchVariables,
+                             [](const char* name) { return std::getenv(name) != nullptr; });
 }
 
 }  // namespace

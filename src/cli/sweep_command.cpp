@@ -178,17 +178,16 @@ int report(const sweep::SweepSpec& spec, const std::vector<int>& outcome,
 
 // An integer option in [min, max]: "VALUE: must be an integer from MIN to MAX (WHAT)".
 CLI::Validator integer_between(long min, long max, const char* what) {
-  return CLI::Validator(
-      [=](std::string& value) -> std::string {
-        try {
-          std::size_t used = 0;
-          const long n = std::stol(value, &used);
-          if (used == value.size() && n >= min && n <= max) return "";
-        } catch (const std::exception&) {  // not a number, or out of long's range
-        }
-        return fmt::format("{}: must be an integer from {} to {} ({})", value, min, max, what);
-      },
-      "INT", what);
+  return {[=](std::string& value) -> std::string {
+            try {
+              std::size_t used = 0;
+              const long n = std::stol(value, &used);
+              if (used == value.size() && n >= min && n <= max) return "";
+            } catch (const std::exception&) {  // not a number, or out of long's range
+            }
+            return fmt::format("{}: must be an integer from {} to {} ({})", value, min, max, what);
+          },
+          "INT", what};
 }
 
 }  // namespace
