@@ -204,10 +204,18 @@ CLI::App* add_sweep_command(CLI::App& app, SweepOptions& options) {
   sweep->add_option("--jobs", options.jobs, "Points run at once on this machine (default 1)")
       ->check(integer_between(1, 1024, "points at once"));
   add_threads_option(*sweep, options.threads);
+  sweep->get_option("--threads")
+      ->description(
+          "Threads per point; 0 = all cores (default: the usable cores / the points running at "
+          "once on this machine; with one at a time, [run].threads, else all cores)");
   sweep
       ->add_option("--index", options.index,
                    "Run only point I (0-based), e.g. $SLURM_ARRAY_TASK_ID; no collect")
       ->check(integer_between(0, std::numeric_limits<int>::max(), "a point number"));
+  sweep->footer(
+      "Exit status: 0 every point finished; 1 a point failed or was not started (the others'\n"
+      "results are kept); 2 invalid run file, [sweep] table or command line (nothing ran);\n"
+      "130/143 stopped by SIGINT/SIGTERM (run the same command again to continue).");
   return sweep;
 }
 
