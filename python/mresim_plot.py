@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Draw DIR/figures/*.png for a finished mresim run:
+"""Draw DIR/figures/*.png for a finished mresim run, or the cross-run figures of a sweep
+directory (sweep.json and collected.h5, mresim_plots/sweep.py):
 
     python3 mresim_plot.py DIR [--step S]... [--plane P]... [--particle K] [--field-map C]...
                                [--animate]
@@ -68,6 +69,8 @@ def main(argv):
     try:
         if not os.path.isdir(directory):
             raise PlotError(f"'{directory}' is not a directory")
+        if _is_sweep_directory(directory):
+            return _plot_sweep(directory, args)
         run = Run(directory, options)
         if not run.run_type:
             raise PlotError(f"{run.h5_path} has no root attribute run_type")
@@ -97,6 +100,39 @@ def main(argv):
         return 1
     names = ", ".join(os.path.basename(p) for p in run.written)
     print(f"{PROG}: wrote {len(run.written)} figure(s) to {run.figures_dir}: {names}")
+    return 0
+
+
+def _is_sweep_directory(directory):
+    """A directory of `mresim sweep` (sweep.json, no results.h5 of its own)."""
+    return (os.path.isfile(os.path.join(directory, "sweep.json"))
+            and not os.path.isfile(os.path.join(directory, "results.h5")))
+
+
+def _plot_sweep(directory, args):
+    """The cross-run figures of a sweep (mresim_plots/sweep.py); no view options."""
+    from mresim_plots import sweep
+    from mresim_plots.common import PlotError
+    given = [f"--{name.replace('_', '-')}" for name in ("step", "plane", "particle",
+                                                          "field_map", "animate")
+             if getattr(args, name)]
+    if given:
+        print(f"{PROG}: error: {', '.join(given)}: view options apply to run directories, not "
+              f"to the sweep directory '{directory}' (plot a point: mresim plot "
+              f"{directory}/point-0000 ...)", file=sys.stderr)
+        return 2
+    try:
+        figures = sweep.Sweep(directory)
+        sweep.plot(figures)
+    except PlotError as e:
+        print(f"{PROG}: error: {e}", file=sys.stderr)
+        return 1
+    except (OSError, KeyError, ValueError, IndexError) as e:
+        print(f"{PROG}: error: cannot plot '{directory}': {type(e).__name__}: {e}",
+              file=sys.stderr)
+        return 1
+    names = ", ".join(os.path.basename(p) for p in figures.written)
+    print(f"{PROG}: wrote {len(figures.written)} figure(s) to {figures.figures_dir}: {names}")
     return 0
 
 

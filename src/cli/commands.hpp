@@ -115,6 +115,27 @@ std::vector<std::string> plot_script_arguments(const PlotOptions& options);
 CLI::App* add_plot_command(CLI::App& app, PlotOptions& options);
 int plot_command(const PlotOptions& options);
 
+// `mresim sweep FILE`: every point of the file's [sweep] table as its own run (docs/sweeps.md).
+struct SweepOptions {
+  std::string file;
+  std::string out;    // empty: ./<run file stem>
+  long jobs = 1;      // points run at once by this process
+  long threads = -1;  // per point; -1: the cores shared by the jobs (sweep_command.cpp)
+  long index = -1;    // >= 0: run only this point (a Slurm array task)
+};
+CLI::App* add_sweep_command(CLI::App& app, SweepOptions& options);
+int sweep_command(const SweepOptions& options);
+
+// `mresim collect DIR`: the collected tables of a sweep directory.
+struct CollectOptions {
+  std::string dir;
+};
+CLI::App* add_collect_command(CLI::App& app, CollectOptions& options);
+int collect_command(const CollectOptions& options);
+
+// `run` and `info` refuse a run file with a [sweep] table (ConfigError pointing to `sweep`).
+void refuse_sweep_file(const config::TableReader& root, const std::string& file);
+
 CLI::App* add_types_command(CLI::App& app);
 int types_command();
 

@@ -22,6 +22,7 @@ CLI::App* add_info_command(CLI::App& app, InfoOptions& options) {
 
 int info_command(const InfoOptions& options) {
   const auto root = config::TableReader::parse_file(options.file, options.overrides);
+  refuse_sweep_file(root, options.file);
   std::string run_type;
   const auto plan = app::make_plan(root, &run_type);
   const app::RunSettings settings = app::read_run_settings(root);

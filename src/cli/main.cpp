@@ -47,12 +47,16 @@ int run_cli(int argc, char** argv) {
   ResumeOptions resume_options;
   ExtendOptions extend_options;
   RerunOptions rerun_options;
+  SweepOptions sweep_options;
+  CollectOptions collect_options;
   CLI::App* run = add_run_command(app, run_options);
   CLI::App* resume = add_resume_command(app, resume_options);
   CLI::App* extend = add_extend_command(app, extend_options);
   CLI::App* rerun = add_rerun_command(app, rerun_options);
   CLI::App* info = add_info_command(app, info_options);
   CLI::App* plot = add_plot_command(app, plot_options);
+  CLI::App* sweep = add_sweep_command(app, sweep_options);
+  CLI::App* collect = add_collect_command(app, collect_options);
   CLI::App* types = add_types_command(app);
 
   // CLI11 would take an unknown command for a stray argument and, with --help, print the main
@@ -87,13 +91,15 @@ int run_cli(int argc, char** argv) {
   }
 
   try {
-    if (*run || *resume || *extend || *rerun) mresim::app::install_stop_handlers();
+    if (*run || *resume || *extend || *rerun || *sweep) mresim::app::install_stop_handlers();
     if (*run) return run_command(run_options);
     if (*resume) return resume_command(resume_options);
     if (*extend) return extend_command(extend_options);
     if (*rerun) return rerun_command(rerun_options);
     if (*info) return info_command(info_options);
     if (*plot) return plot_command(plot_options);
+    if (*sweep) return sweep_command(sweep_options);
+    if (*collect) return collect_command(collect_options);
     if (*types) return types_command();
   } catch (const mresim::config::ConfigError& e) {
     return report_error(e.what(), kInvalidInput);

@@ -5,6 +5,7 @@
 #include "cli/commands.hpp"
 #include "cli/plotting.hpp"
 #include "mresim/io/run_directory.hpp"
+#include "mresim/sweep/sweep_directory.hpp"
 
 namespace mresim::cli {
 
@@ -57,6 +58,10 @@ std::vector<std::string> plot_script_arguments(const PlotOptions& options) {
 }
 
 int plot_command(const PlotOptions& options) {
+  // A sweep directory: the cross-run figures from its collected tables (docs/sweeps.md).
+  if (sweep::is_sweep_directory(options.dir) && !io::RunDirectory::is_run_directory(options.dir)) {
+    return draw_figures(options.dir, plot_script_arguments(options));
+  }
   if (!io::RunDirectory::is_run_directory(options.dir)) {
     throw io::OutputDirectoryError(
         fmt::format("'{}' is not an mresim run directory (no results.h5 in it)", options.dir));

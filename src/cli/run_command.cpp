@@ -55,6 +55,7 @@ int run_command(const RunOptions& options) {
   // 1. Parse and validate the whole run file, unknown keys included, before touching the disk.
   // --set overrides are applied to the parsed file first, so they are validated as the file is.
   const auto root = config::TableReader::parse_file(options.file, options.overrides);
+  refuse_sweep_file(root, options.file);
   std::string run_type;
   const auto plan = app::make_plan(root, &run_type);
 
