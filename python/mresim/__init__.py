@@ -22,10 +22,30 @@ The two-dipole models at single states are in :mod:`mresim.pair`. Bad input rais
 whole API.
 """
 
-from ._core import ConfigError, OutputDirectoryError, __version__
-from .results import Group, Results, load
-from .runs import InvalidResultsError, Run, info, run, run_types
-from . import pair
+import os as _os
+from pathlib import Path as _Path
+
+
+def _find_installed_plot_scripts():
+    """An installed package (cmake --install) lies in <prefix>/<python dir>/mresim and the
+    plotting scripts in <prefix>/share/mresim/python: found upwards from here, wherever the prefix
+    was moved. The build tree's module finds the source tree's scripts without this."""
+    for parent in _Path(__file__).resolve().parents:
+        scripts = parent / "share" / "mresim" / "python"
+        if (scripts / "mresim_plot.py").is_file():
+            return str(scripts)
+    return None
+
+
+# The figures of a run are drawn by those scripts (what `mresim run` does); an explicit
+# MRESIM_PYTHON_DIR wins.
+if not _os.environ.get("MRESIM_PYTHON_DIR") and _find_installed_plot_scripts():
+    _os.environ["MRESIM_PYTHON_DIR"] = _find_installed_plot_scripts()
+
+from ._core import ConfigError, OutputDirectoryError, __version__  # noqa: E402
+from .results import Group, Results, load  # noqa: E402
+from .runs import InvalidResultsError, Run, info, run, run_types  # noqa: E402
+from . import pair  # noqa: E402
 
 __all__ = [
     "ConfigError",

@@ -36,3 +36,22 @@ cd "$tmp"
 ls "$tmp/run/figures/"*.png > /dev/null 2>&1 || fail "no figures: $(cat "$tmp/run.out" "$tmp/run.err")"
 grep -q "wrote .* figure" "$tmp/run.out" || fail "the plotting script said nothing"
 echo "install_relocated: ok ($(ls "$tmp/run/figures" | wc -l) figures)"
+
+# The Python module (when built): imported from the moved prefix, it runs the same example and
+# draws its figures with the prefix's plotting scripts.
+init=$(find "$tmp/moved" -path '*/mresim/__init__.py' | head -n 1)
+if [ -n "$init" ]; then
+  package_dir=$(dirname "$(dirname "$init")")
+  PYTHONPATH="$package_dir" /usr/bin/python3 - "$source/examples/fig2_2_single_spring_axial.toml" \
+    "$tmp/python-run" "$moved_scripts" > "$tmp/python.out" 2>&1 <<'PY' || fail "python: $(cat "$tmp/python.out")"
+import os, pathlib, sys
+import mresim
+assert os.environ["MRESIM_PYTHON_DIR"] == sys.argv[3], os.environ.get("MRESIM_PYTHON_DIR")
+results = mresim.run(pathlib.Path(sys.argv[1]), out=sys.argv[2], plot=True)
+assert results.cases[0]["field"].size > 0
+assert list(pathlib.Path(sys.argv[2], "figures").glob("*.png")), "no figures"
+PY
+  echo "install_relocated: the installed Python module ran the example"
+else
+  echo "install_relocated: no Python module installed (MRESIM_BUILD_PYTHON=OFF)"
+fi

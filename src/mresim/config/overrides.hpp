@@ -38,4 +38,8 @@ void apply_overrides(toml::table& root, const std::vector<std::string>& argument
 // is validated and recorded when there are overrides. Parsing it gives `root` back.
 [[nodiscard]] std::string toml_text(const toml::table& root);
 
+// `text` as a TOML basic string: in double quotes, with ", \ and control characters escaped
+// (defined in table_reader.cpp, whose messages show string values this way).
+[[nodiscard]] std::string toml_string_literal(std::string_view text);
+
 }  // namespace mresim::config

@@ -47,32 +47,6 @@ std::string join(const std::vector<std::string>& items) {
   return fmt::format("{}", fmt::join(items, ", "));
 }
 
-std::string quote(std::string_view s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out + "\"";
-}
-
 // Shortest text that reads back to the same double, keeping a float recognisable as one
 // ("2.0", not "2", so that "expected an integer" makes sense).
 std::string format_float(double x) {
@@ -83,7 +57,7 @@ std::string format_float(double x) {
 
 // The value roughly as the user wrote it, short enough for a one-line message.
 std::string format_node(const toml::node& node) {
-  if (const auto* s = node.as_string()) return quote(s->get());
+  if (const auto* s = node.as_string()) return toml_string_literal(s->get());
   if (const auto* i = node.as_integer()) return fmt::format("{}", i->get());
   if (const auto* f = node.as_floating_point()) return format_float(f->get());
   if (const auto* b = node.as_boolean()) return b->get() ? "true" : "false";
@@ -590,6 +564,32 @@ void TableReader::reject_unknown_keys() const {
         return std::tie(a.line, a.column) < std::tie(b.line, b.column);
       });
   throw ConfigError(first->message);
+}
+
+std::string toml_string_literal(std::string_view s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out + "\"";
 }
 
 }  // namespace mresim::config

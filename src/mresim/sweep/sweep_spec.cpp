@@ -32,32 +32,6 @@ bool is_bare_key(std::string_view key) {
   });
 }
 
-std::string quoted(std::string_view text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      default:
-        out.push_back(c);
-    }
-  }
-  return out + "\"";
-}
-
 std::string float_text(double v) {
   if (std::isnan(v)) return "nan";
   if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
@@ -123,7 +97,7 @@ std::string toml_value_text(const toml::node& node) {
   if (const auto* v = node.as_integer()) return std::to_string(v->get());
   if (const auto* v = node.as_floating_point()) return float_text(v->get());
   if (const auto* v = node.as_boolean()) return v->get() ? "true" : "false";
-  if (const auto* v = node.as_string()) return quoted(v->get());
+  if (const auto* v = node.as_string()) return config::toml_string_literal(v->get());
   if (const auto* array = node.as_array()) {
     std::string text = "[";
     for (std::size_t i = 0; i < array->size(); ++i) {
@@ -136,9 +110,9 @@ std::string toml_value_text(const toml::node& node) {
     bool first = true;
     for (const auto& [name, value] : *table) {
       const std::string_view key = name.str();
-      text +=
-          fmt::format("{}{} = {}", first ? "" : ", ",
-                      is_bare_key(key) ? std::string(key) : quoted(key), toml_value_text(value));
+      text += fmt::format("{}{} = {}", first ? "" : ", ",
+                          is_bare_key(key) ? std::string(key) : config::toml_string_literal(key),
+                          toml_value_text(value));
       first = false;
     }
     return text + "}";
