@@ -566,9 +566,9 @@ void TableReader::reject_unknown_keys() const {
   throw ConfigError(first->message);
 }
 
-std::string toml_string_literal(std::string_view s) {
+std::string toml_string_literal(std::string_view text) {
   std::string out = "\"";
-  for (const char c : s) {
+  for (const char c : text) {
     switch (c) {
       case '"':
         out += "\\\"";
