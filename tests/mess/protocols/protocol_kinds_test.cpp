@@ -162,8 +162,11 @@ TEST(MessProtocolKinds, NewtonRunFollowsTheLbfgsLoop) {
     EXPECT_LT((a.centres - b.centres).cwiseAbs().maxCoeff(), 1e-9) << k;
     EXPECT_NEAR(b.energies.total(), a.energies.total(), 1e-6 * std::abs(a.energies.total()) + 1e-22)
         << k;
+    EXPECT_EQ(a.krylov_iterations, 0) << k;  // L-BFGS does no CG
     if (k > 0) {
       EXPECT_LT(b.iterations, a.iterations) << k;  // Newton steps against L-BFGS steps
+      // Newton's directions come from CG (recorded per step).
+      if (b.iterations > 0) EXPECT_GT(b.krylov_iterations, 0) << k;
     }
   }
 }

@@ -111,6 +111,8 @@ void write_step_records(io::Hdf5File& file, const std::string& group,
                         int_column(records, [](auto& r) { return r.iterations; }));
   file.write_int_vector(s + "evaluations",
                         int_column(records, [](auto& r) { return r.evaluations; }));
+  file.write_int_vector(s + "krylov_iterations",
+                        int_column(records, [](auto& r) { return r.krylov_iterations; }));
   file.write_vector(s + "max_force", column(records, [](auto& r) { return r.max_force; }), "N");
   file.write_int_vector(s + "magnetization_solves",
                         int_column(records, [](auto& r) { return r.magnetization_solves; }));
@@ -170,6 +172,10 @@ std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std:
   const std::vector<std::string> status = file.strings(s + "status");
   const std::vector<std::int64_t> iterations = ints(s + "iterations");
   const std::vector<std::int64_t> evaluations = ints(s + "evaluations");
+  // Absent in files written before the CG counts were recorded: zero.
+  const std::vector<std::int64_t> krylov = file.exists(s + "krylov_iterations")
+                                               ? ints(s + "krylov_iterations")
+                                               : std::vector<std::int64_t>(n, 0);
   const std::vector<double> max_force = doubles(s + "max_force");
   const std::vector<std::int64_t> solves = ints(s + "magnetization_solves");
   const std::vector<std::int64_t> unconverged = ints(s + "unconverged_magnetization_solves");
@@ -193,6 +199,7 @@ std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std:
     r.status = status[i];
     r.iterations = iterations[i];
     r.evaluations = evaluations[i];
+    r.krylov_iterations = krylov[i];
     r.max_force = max_force[i];
     r.magnetization_solves = solves[i];
     r.unconverged_magnetization_solves = unconverged[i];

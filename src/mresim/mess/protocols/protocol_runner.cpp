@@ -111,6 +111,7 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
     record.status = to_string(r.status);
     record.iterations = r.iterations;
     record.evaluations = r.evaluations;
+    record.krylov_iterations = r.krylov_iterations;
     record.max_force = r.max_force;
     record.energies = r.final.energies;
   } else {

@@ -47,11 +47,12 @@ struct StepRecord {
   Eigen::Matrix3Xd magnetization;                        // A/m, 3 x N_p
 
   // Solver diagnostics.
-  bool converged = false;        // relaxation converged and the final magnetization solve too
-  std::string status;            // the relaxation method's status
-  std::int64_t iterations = 0;   // minimiser iterations or leapfrog time steps
-  std::int64_t evaluations = 0;  // force evaluations
-  double max_force = 0.0;        // N (minimiser); leapfrog: mean |a| of its last round, scaled
+  bool converged = false;              // relaxation converged and the final magnetization solve too
+  std::string status;                  // the relaxation method's status
+  std::int64_t iterations = 0;         // minimiser iterations or leapfrog time steps
+  std::int64_t evaluations = 0;        // force evaluations
+  std::int64_t krylov_iterations = 0;  // newton: CG iterations (Hessian products); else 0
+  double max_force = 0.0;  // N (minimiser); leapfrog: mean |a| of its last round, scaled
   std::int64_t magnetization_solves = 0;
   std::int64_t unconverged_magnetization_solves = 0;
   std::string magnetization_method;  // of the final solve

@@ -6,6 +6,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "mresim/mess/solvers/vector_algebra.hpp"
+
 namespace mresim::mess::detail {
 
 namespace {
@@ -178,27 +180,28 @@ Eigen::VectorXd NewtonSolver::elastic_precondition(const Eigen::VectorXd& r) con
 }
 
 Eigen::VectorXd NewtonSolver::newton_direction(const Eigen::VectorXd& g, double eta) {
+  // Vector algebra on both cores, independent of the thread count (vector_algebra.hpp).
   Eigen::VectorXd x = Eigen::VectorXd::Zero(g.size());
   Eigen::VectorXd r = -g;
   Eigen::VectorXd z = precondition(r);
   Eigen::VectorXd p = z;
-  double rz = r.dot(z);
-  const double target = eta * g.norm();
+  double rz = parallel_dot(r, z);
+  const double target = eta * std::sqrt(parallel_dot(g, g));
   for (int k = 0; k < options_.max_krylov_iterations; ++k) {
     const Eigen::VectorXd hp = hessian_product(p);
     ++krylov_iterations_;
-    const double curvature = p.dot(hp);
+    const double curvature = parallel_dot(p, hp);
     if (!(curvature > 0.0)) {
       // Negative curvature: the iterate so far, or the preconditioned steepest descent.
       return k == 0 ? p : x;
     }
     const double alpha = rz / curvature;
-    x += alpha * p;
-    r -= alpha * hp;
-    if (r.norm() <= target) break;
+    parallel_axpy(alpha, p, x);
+    if (std::sqrt(parallel_axpy_dot(-alpha, hp, r, r)) <= target) break;
     z = precondition(r);
-    const double rz_next = r.dot(z);
-    p = z + (rz_next / rz) * p;
+    const double rz_next = parallel_dot(r, z);
+    // p = z + beta p
+    parallel_scale_add(rz_next / rz, z, p);
     rz = rz_next;
   }
   return x;

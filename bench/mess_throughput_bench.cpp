@@ -1,0 +1,218 @@
+// Throughput of one energy + gradient evaluation of the 3D model at full size, printed next to
+// the memory-bandwidth bound of its data layout, measured in the same run.
+//
+// Systems: the run files of Fig. 4.11 (two particles, 44 x 44 x 147 = 284,592 nodes) and of
+// the Fig. 4.25 helix (eight particles, 66 x 66 x 228 = 993,168 nodes), built exactly as
+// `mresim run` builds them, with every free node displaced at random by up to 0.05 l_e so that
+// every spring and cell is strained (the cost of an evaluation does not depend on the state).
+//
+// Printed per system and thread count (1, then 2; the results are bitwise the same):
+//  - the whole evaluation (MessSystem::evaluate: every energy term, the magnetization held);
+//  - the elastic kernels alone (springs + volume, ElasticTerms::evaluate);
+// each as nodes per second (best of the repeats) and as a fraction of the bandwidth bound.
+//
+// Bandwidth bound = measured bandwidth / bytes the kernels stream per node. The bandwidth is a
+// STREAM-like triad a[i] = b[i] + s c[i] over 3 x 256 MiB, counted as 24 bytes per i, best of
+// five, with the same thread count. The bytes per node count every array the two elastic
+// kernels sweep once per evaluation (elastic_terms.cpp), with the lattice's own spring and cell
+// counts:
+//   springs, per spring: first + second + stiffness + kind read (17 B), tension written and
+//     read back (16 B), two incidence entries (8 B), the gather's second read of first and
+//     second for each end (16 B);
+//   volume, per cell: the 8 vertex indices (32 B), 9 scratch doubles written and read (144 B),
+//     eight incidence entries (32 B);
+//   per node, each kernel: the positions read twice (48 B), the gradient read and written
+//     (48 B), the incidence offsets (8 B).
+// Neighbouring positions are assumed to come from cache (the best case for the layout), so
+// the bound is optimistic. The same counting for a stencil layout (no index arrays or scratch:
+// positions read once, gradient written once, one material byte) gives 49 B per node; that
+// line is printed as the bound a layout without index arrays could approach.
+//
+//   ./build/mess_throughput_bench                  (both systems)
+//   ./build/mess_throughput_bench --repeats 10 --only fig4_11
+#include <omp.h>
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "mresim/config/table_reader.hpp"
+#include "mresim/mess/protocols/protocol_runner.hpp"
+#include "mresim/mess/run_file/mess_spec.hpp"
+#include "mresim/mess/terms/elastic_terms.hpp"
+
+namespace {
+
+namespace mess = mresim::mess;
+
+struct SystemFile {
+  const char* name;
+  const char* path;  // relative to the source tree
+};
+
+constexpr SystemFile kSystems[] = {
+    {"fig4_11", "examples/chapter4/fig4_11_pair_large_box_S6_5um.toml"},
+    {"fig4_25_helix", "examples/chapter4/fig4_25_helix_R3_5um.toml"},
+};
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// STREAM-like triad with `threads` threads: best bandwidth of five passes, bytes/s.
+double triad_bandwidth(int threads) {
+  constexpr std::size_t kCount = std::size_t{1} << 25;  // 256 MiB per array
+  std::vector<double> a(kCount);
+  std::vector<double> b(kCount);
+  std::vector<double> c(kCount);
+  const auto n = static_cast<std::int64_t>(kCount);
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (std::int64_t i = 0; i < n; ++i) {  // first touch by the threads that use the pages
+    a[i] = 0.0;
+    b[i] = 1.0;
+    c[i] = 2.0;
+  }
+  double best = 1e300;
+  for (int pass = 0; pass < 5; ++pass) {
+    const auto start = std::chrono::steady_clock::now();
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (std::int64_t i = 0; i < n; ++i) a[i] = b[i] + 0.5 * c[i];
+    best = std::min(best, seconds_since(start));
+  }
+  if (a[kCount / 2] != 2.0) std::abort();  // keeps the loop and checks it ran
+  return 24.0 * static_cast<double>(kCount) / best;
+}
+
+// Bytes the elastic kernels stream per node (see the header for the counting).
+double elastic_bytes_per_node(const mresim::lattice::Lattice& lattice) {
+  const auto nodes = static_cast<double>(lattice.node_count());
+  const auto springs = static_cast<double>(lattice.springs.size());
+  const auto cells = static_cast<double>(lattice.elements.size());
+  const double per_spring = 17.0 + 16.0 + 8.0 + 16.0;
+  const double per_cell = 32.0 + 144.0 + 32.0;
+  const double per_node_per_kernel = 48.0 + 48.0 + 8.0;
+  return (per_spring * springs + per_cell * cells) / nodes + 2.0 * per_node_per_kernel;
+}
+constexpr double kStencilBytesPerNode = 24.0 + 24.0 + 1.0;
+
+// Best time of `repeats` calls of f().
+template <class F>
+double best_seconds(int repeats, F&& f) {
+  double best = 1e300;
+  for (int k = 0; k < repeats; ++k) {
+    const auto start = std::chrono::steady_clock::now();
+    f();
+    best = std::min(best, seconds_since(start));
+  }
+  return best;
+}
+
+struct Measured {
+  double whole = 0.0;    // s per evaluation
+  double elastic = 0.0;  // s per evaluation
+  Eigen::Matrix3Xd gradient;
+};
+
+Measured measure(mess::MessSystem& system, const mess::ElasticTerms& elastic, int threads,
+                 int repeats) {
+  omp_set_num_threads(threads);
+  Measured m;
+  m.gradient.resize(3, system.node_count());
+  (void)system.evaluate(&m.gradient);  // warm-up (first touch of the scratch arrays)
+  m.whole = best_seconds(repeats, [&] { (void)system.evaluate(&m.gradient); });
+  Eigen::Matrix3Xd elastic_gradient(3, system.node_count());
+  (void)elastic.evaluate(system.lattice(), system.positions(), &elastic_gradient);
+  m.elastic = best_seconds(repeats, [&] {
+    (void)elastic.evaluate(system.lattice(), system.positions(), &elastic_gradient);
+  });
+  return m;
+}
+
+void run_system(const SystemFile& file, int repeats, const double bandwidth[3]) {
+  const std::string path = std::string(MRESIM_SOURCE_DIR) + "/" + file.path;
+  const mresim::mess_config::MessSpec spec =
+      mresim::mess_config::read_mess_run_file(mresim::config::TableReader::parse_file(path));
+  const auto build_start = std::chrono::steady_clock::now();
+  const mresim::mess_protocol::ProtocolRunner runner(spec);
+  mess::MessSystem system = runner.system();
+  const double build_seconds = seconds_since(build_start);
+  const std::int64_t nodes = system.node_count();
+  // Strain every spring and cell: random displacements of up to 0.05 l_e (fixed seed).
+  std::mt19937_64 random(20261202);
+  std::uniform_real_distribution<double> jitter(-0.05, 0.05);
+  Eigen::Matrix3Xd x = system.positions();
+  for (Eigen::Index n = 0; n < x.cols(); ++n) {
+    for (int a = 0; a < 3; ++a) x(a, n) += jitter(random) * system.length_scale();
+  }
+  system.set_positions(x);
+  (void)system.solve_magnetization();
+  const mess::ElasticTerms elastic(system.lattice(), {});
+
+  const double bytes = elastic_bytes_per_node(system.lattice());
+  std::printf("\n%s: %lld nodes, %zu springs, %zu cells, %zu particles (built in %.1f s)\n",
+              file.name, static_cast<long long>(nodes), system.lattice().springs.size(),
+              system.lattice().elements.size(), system.particle_count(), build_seconds);
+  std::printf("  bytes the elastic kernels stream per node: %.0f (a stencil layout: %.0f)\n", bytes,
+              kStencilBytesPerNode);
+  Eigen::Matrix3Xd first_gradient;
+  for (const int threads : {1, 2}) {
+    const Measured m = measure(system, elastic, threads, repeats);
+    const double bound = bandwidth[threads] / bytes;  // nodes/s
+    const double stencil_bound = bandwidth[threads] / kStencilBytesPerNode;
+    const double whole_rate = static_cast<double>(nodes) / m.whole;
+    const double elastic_rate = static_cast<double>(nodes) / m.elastic;
+    std::printf(
+        "  %d thread%s: whole evaluation %7.2f ms = %6.2f M nodes/s; elastic kernels %7.2f ms = "
+        "%6.2f M nodes/s = %3.0f %% of the layout's bound (%.1f M nodes/s); stencil bound %.0f M "
+        "nodes/s\n",
+        threads, threads == 1 ? " " : "s", 1e3 * m.whole, 1e-6 * whole_rate, 1e3 * m.elastic,
+        1e-6 * elastic_rate, 100.0 * elastic_rate / bound, 1e-6 * bound, 1e-6 * stencil_bound);
+    if (threads == 1) {
+      first_gradient = m.gradient;
+    } else {
+      std::printf("  gradient with 2 threads %s the one with 1 thread\n",
+                  first_gradient == m.gradient ? "bitwise equals" : "DIFFERS FROM");
+    }
+  }
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int repeats = 5;
+  std::string only;
+  for (int k = 1; k + 1 < argc; k += 2) {
+    const std::string key = argv[k];
+    if (key == "--repeats") {
+      repeats = std::max(1, std::atoi(argv[k + 1]));
+    } else if (key == "--only") {
+      only = argv[k + 1];
+    } else {
+      std::fprintf(stderr, "unknown option %s (--repeats N, --only fig4_11|fig4_25_helix)\n",
+                   argv[k]);
+      return 2;
+    }
+  }
+  double load[3] = {0, 0, 0};
+  if (getloadavg(load, 3) > 0) std::printf("load average at start: %.2f\n", load[0]);
+  double bandwidth[3] = {0.0, 0.0, 0.0};
+  for (const int threads : {1, 2}) {
+    bandwidth[threads] = triad_bandwidth(threads);
+    std::printf("triad bandwidth, %d thread%s: %.1f GB/s\n", threads, threads == 1 ? "" : "s",
+                1e-9 * bandwidth[threads]);
+  }
+  for (const SystemFile& file : kSystems) {
+    if (only.empty() || only == file.name) run_system(file, repeats, bandwidth);
+  }
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  std::printf("\npeak resident memory of the process: %.1f MiB\n",
+              static_cast<double>(usage.ru_maxrss) / 1024.0);
+  return 0;
+}
