@@ -39,6 +39,15 @@ TEST(MessOutputs, ResultsSummaryAndXdmfAreConsistent) {
   EXPECT_EQ(h5.shape("/steps/centres"), (std::vector<hsize_t>{steps, 2, 3}));
   EXPECT_EQ(h5.shape("/steps/cluster_id"), (std::vector<hsize_t>{steps, 2}));
   EXPECT_EQ(h5.strings("/steps/solver/status").size(), steps);
+  // The measured peak memory of the run, absolute and per node: the
+  // process held at least its lattice (positions alone are 24 bytes per node).
+  const auto peak = static_cast<double>(
+      h5.scalar_attribute<long long>("/", "peak_resident_memory_bytes", H5T_NATIVE_LLONG));
+  const auto per_node =
+      h5.scalar_attribute<double>("/", "peak_resident_memory_bytes_per_node", H5T_NATIVE_DOUBLE);
+  EXPECT_GT(per_node, 24.0);
+  EXPECT_NEAR(per_node * static_cast<double>(h5.shape("/lattice/initial_positions")[0]), peak,
+              1e-6 * peak);
   // The energy terms add up to the total (self_linearized is reported only).
   const auto total = h5.doubles("/steps/energies/total");
   for (std::size_t s = 0; s < steps; ++s) {

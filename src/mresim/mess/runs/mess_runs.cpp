@@ -15,6 +15,7 @@
 #include <string>
 
 #include "mresim/app/invalid_results.hpp"
+#include "mresim/app/peak_memory.hpp"
 #include "mresim/app/run_output.hpp"
 #include "mresim/app/run_type.hpp"
 #include "mresim/app/stop_signal.hpp"
@@ -96,6 +97,7 @@ class MessPlan final : public app::RunPlan {
     }
 
     const MessResultCheck check = write_mess_results(staging_dir, results, runner, state.records);
+    write_peak_memory(results, runner.system().node_count(), progress);
     publish_pending_history(staging_dir, results, runner);          // an extended run's /history
     pair::runs::write_warnings_attribute(results, spec_.warnings);  // /@warnings, as pair runs
     warn_about_intermediate_solves(state.records);
@@ -116,6 +118,19 @@ class MessPlan final : public app::RunPlan {
   }
 
  private:
+  // The process's peak resident memory so far (the relaxations are done), in results.h5 and
+  // in the log, absolute and per lattice node.
+  static void write_peak_memory(io::Hdf5File& results, std::int64_t nodes,
+                                app::Progress& progress) {
+    const std::int64_t peak = app::peak_resident_memory_bytes();
+    if (peak <= 0) return;
+    const double per_node = static_cast<double>(peak) / static_cast<double>(nodes);
+    results.write_int_attribute("/", "peak_resident_memory_bytes", peak);
+    results.write_number_attribute("/", "peak_resident_memory_bytes_per_node", per_node);
+    progress.note(fmt::format("mresim: peak resident memory {:.1f} MiB ({:.0f} bytes per node)",
+                              static_cast<double>(peak) / (1 << 20), per_node));
+  }
+
   // "mresim: lattice 42 x 42 x 83 nodes (146412 nodes, 5 particles), 21 steps, solver lbfgs,
   // memory estimate 230.1 MiB (available 100.0 GiB, MemAvailable)".
   std::string setup_line() const {
