@@ -19,28 +19,6 @@ lattice::CellVertices gather_vertices(const std::array<std::int32_t, 8>& element
   return v;
 }
 
-// Builds node -> entries lists by counting sort; entries of a node keep increasing order of
-// the producing item, so the gather order is fixed.
-template <class ForEach>
-void build_incidence(std::int64_t node_count, std::int64_t items, int per_item, ForEach node_of,
-                     std::vector<std::int64_t>& offsets, std::vector<std::int32_t>& entries) {
-  offsets.assign(static_cast<std::size_t>(node_count + 1), 0);
-  for (std::int64_t i = 0; i < items; ++i) {
-    for (int k = 0; k < per_item; ++k) ++offsets[static_cast<std::size_t>(node_of(i, k)) + 1];
-  }
-  for (std::int64_t n = 0; n < node_count; ++n) {
-    offsets[static_cast<std::size_t>(n + 1)] += offsets[static_cast<std::size_t>(n)];
-  }
-  entries.resize(static_cast<std::size_t>(offsets.back()));
-  std::vector<std::int64_t> fill(offsets.begin(), offsets.end() - 1);
-  for (std::int64_t i = 0; i < items; ++i) {
-    for (int k = 0; k < per_item; ++k) {
-      entries[static_cast<std::size_t>(fill[static_cast<std::size_t>(node_of(i, k))]++)] =
-          static_cast<std::int32_t>(i * per_item + k);
-    }
-  }
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------- serial reference formulas
@@ -95,14 +73,21 @@ void add_volume_gradient(const std::vector<std::array<std::int32_t, 8>>& element
 
 namespace {
 
-constexpr std::size_t kIncidenceLimitSprings = std::size_t{1} << 30;  // 2 s + 1 fits int32
-constexpr std::size_t kIncidenceLimitCells = std::size_t{1} << 28;    // 8 c + 7 fits int32
-
 // Runs body(i) for i < n, in parallel for large n; each i writes only its own scratch slot.
 template <class Body>
 void for_each_item(std::int64_t n, Body&& body) {
 #pragma omp parallel for schedule(static) if (n >= detail::kParallelMinimum)
   for (std::int64_t i = 0; i < n; ++i) body(i);
+}
+
+// element_length * rest_length_factor(kind), indexed by kind (SpringSet::rest_length).
+std::array<double, 3> rest_lengths_by_kind(const lattice::SpringSet& sp) {
+  std::array<double, 3> lengths{};
+  for (const auto kind :
+       {lattice::SpringKind::edge, lattice::SpringKind::face, lattice::SpringKind::body}) {
+    lengths[static_cast<std::size_t>(kind)] = sp.element_length * lattice::rest_length_factor(kind);
+  }
+  return lengths;
 }
 
 // The spring's Hessian block B = k [(1 - L/l) I + (L/l) r^ r^T].
@@ -125,19 +110,8 @@ void check_shapes(const char* who, std::int64_t node_count, const lattice::Latti
 
 }  // namespace
 
-SpringKernel::SpringKernel(const lattice::Lattice& lat) : node_count_(lat.node_count()) {
-  const lattice::SpringSet& sp = lat.springs;
-  if (sp.size() >= kIncidenceLimitSprings) {
-    throw std::invalid_argument("ElasticTerms: too many springs for 32-bit incidence");
-  }
-  build_incidence(
-      node_count_, static_cast<std::int64_t>(sp.size()), 2,
-      [&](std::int64_t s, int k) {
-        return k == 0 ? sp.first[static_cast<std::size_t>(s)]
-                      : sp.second[static_cast<std::size_t>(s)];
-      },
-      offsets_, entries_);
-}
+SpringKernel::SpringKernel(const lattice::Lattice& lat)
+    : node_count_(lat.node_count()), stencil_(lat) {}
 
 ElasticValue SpringKernel::evaluate(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
                                     Eigen::Matrix3Xd* gradient) const {
@@ -146,32 +120,23 @@ ElasticValue SpringKernel::evaluate(const lattice::Lattice& lat, const Eigen::Ma
   const auto springs = static_cast<std::int64_t>(sp.size());
   const bool want_gradient = gradient != nullptr;
   if (want_gradient) scratch_.resize(static_cast<std::size_t>(springs));
+  // Rest lengths by kind, the values sp.rest_length(s) gives, looked up without a call.
+  const std::array<double, 3> rest_length = rest_lengths_by_kind(sp);
   // Energy (eq. 4.62) and tension k (l - L)/l (eq. 4.63).
   const auto sums = detail::fixed_order_sums(springs, [&](std::int64_t s) {
     const auto u = static_cast<std::size_t>(s);
     const double l = (x.col(sp.second[u]) - x.col(sp.first[u])).norm();
-    const double stretch = l - sp.rest_length(u);
+    const double stretch = l - rest_length[static_cast<std::size_t>(sp.kind[u])];
     if (want_gradient) scratch_[u] = sp.stiffness[u] * stretch / l;
     const double k_stretch = sp.stiffness[u] * stretch;
     return std::array<double, 2>{0.5 * k_stretch * stretch, std::abs(k_stretch) * l};
   });
   if (gradient == nullptr) return {sums[0], sums[1]};
-    // Gather: every node sums its own springs in a fixed order (no races, no atomics).
-#pragma omp parallel for schedule(static) if (node_count_ >= detail::kParallelMinimum / 4)
-  for (std::int64_t n = 0; n < node_count_; ++n) {
-    Eigen::Vector3d g = gradient->col(n);
-    for (std::int64_t k = offsets_[n]; k < offsets_[n + 1]; ++k) {
-      const std::int32_t entry = entries_[static_cast<std::size_t>(k)];
-      const auto s = static_cast<std::size_t>(entry >> 1);
-      const Eigen::Vector3d r = x.col(sp.second[s]) - x.col(sp.first[s]);
-      if (entry & 1) {
-        g += scratch_[s] * r;
-      } else {
-        g -= scratch_[s] * r;
-      }
-    }
-    gradient->col(n) = g;
-  }
+  // Gather: every node sums its own springs in a fixed order (no races, no atomics).
+  stencil_.gather(*gradient, [&](std::int64_t s, std::int64_t first, std::int64_t second) {
+    const Eigen::Vector3d r = x.col(second) - x.col(first);
+    return Eigen::Vector3d(scratch_[static_cast<std::size_t>(s)] * r);
+  });
   return {sums[0], sums[1]};
 }
 
@@ -180,27 +145,22 @@ void SpringKernel::add_hessian_product(const lattice::Lattice& lat, const Eigen:
   check_shapes("SpringKernel::add_hessian_product", node_count_, lat, x);
   const lattice::SpringSet& sp = lat.springs;
   scratch_.resize(3 * sp.size());
-  // w_s = B_s (v_j - v_i): +w_s on the second end, -w_s on the first.
+  const std::array<double, 3> rest_length = rest_lengths_by_kind(sp);
+  // w_s = B_s (v_j - v_i) = k [(1 - L/l) dv + (L/l) u (u . dv)], u = r/l, without forming B:
+  // +w_s on the second end, -w_s on the first.
   for_each_item(static_cast<std::int64_t>(sp.size()), [&](std::int64_t s) {
-    const auto u = static_cast<std::size_t>(s);
+    const auto i = static_cast<std::size_t>(s);
+    const Eigen::Vector3d r = x.col(sp.second[i]) - x.col(sp.first[i]);
+    const double l = r.norm();
+    const double ratio = rest_length[static_cast<std::size_t>(sp.kind[i])] / l;
+    const Eigen::Vector3d u = r / l;
+    const Eigen::Vector3d dv = v.col(sp.second[i]) - v.col(sp.first[i]);
     Eigen::Map<Eigen::Vector3d>(scratch_.data() + 3 * s) =
-        spring_block(sp, u, x) * (v.col(sp.second[u]) - v.col(sp.first[u]));
+        sp.stiffness[i] * ((1.0 - ratio) * dv + (ratio * u.dot(dv)) * u);
   });
-#pragma omp parallel for schedule(static) if (node_count_ >= detail::kParallelMinimum / 4)
-  for (std::int64_t n = 0; n < node_count_; ++n) {
-    Eigen::Vector3d g = out.col(n);
-    for (std::int64_t k = offsets_[n]; k < offsets_[n + 1]; ++k) {
-      const std::int32_t entry = entries_[static_cast<std::size_t>(k)];
-      const Eigen::Map<const Eigen::Vector3d> w(scratch_.data() +
-                                                3 * static_cast<std::int64_t>(entry >> 1));
-      if (entry & 1) {
-        g += w;
-      } else {
-        g -= w;
-      }
-    }
-    out.col(n) = g;
-  }
+  stencil_.gather(out, [&](std::int64_t s, std::int64_t, std::int64_t) {
+    return Eigen::Vector3d(Eigen::Map<const Eigen::Vector3d>(scratch_.data() + 3 * s));
+  });
 }
 
 void SpringKernel::add_hessian_blocks(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
@@ -252,33 +212,19 @@ Eigen::Vector3d vertex_signs(int v) {
 
 }  // namespace
 
-VolumeKernel::VolumeKernel(const lattice::Lattice& lat) : node_count_(lat.node_count()) {
-  if (lat.elements.size() >= kIncidenceLimitCells) {
-    throw std::invalid_argument("ElasticTerms: too many cells for 32-bit incidence");
-  }
-  build_incidence(
-      node_count_, static_cast<std::int64_t>(lat.elements.size()), 8,
-      [&](std::int64_t c, int v) { return lat.elements[static_cast<std::size_t>(c)][v]; }, offsets_,
-      entries_);
-}
+VolumeKernel::VolumeKernel(const lattice::Lattice& lat)
+    : node_count_(lat.node_count()), stencil_(lat.shape) {}
 
 void VolumeKernel::gather(const std::vector<double>& terms, Eigen::Matrix3Xd& out) const {
-#pragma omp parallel for schedule(static) if (node_count_ >= detail::kParallelMinimum / 4)
-  for (std::int64_t n = 0; n < node_count_; ++n) {
-    Eigen::Vector3d g = out.col(n);
-    for (std::int64_t k = offsets_[n]; k < offsets_[n + 1]; ++k) {
-      const std::int32_t entry = entries_[static_cast<std::size_t>(k)];
-      const int v = entry & 7;
-      const double* t = terms.data() + 9 * static_cast<std::int64_t>(entry >> 3);
-      const double sa = (v & 2) ? 1.0 : -1.0;
-      const double sb = (v & 4) ? 1.0 : -1.0;
-      const double sc = (v & 1) ? 1.0 : -1.0;
-      g += sa * Eigen::Map<const Eigen::Vector3d>(t) +
-           sb * Eigen::Map<const Eigen::Vector3d>(t + 3) +
-           sc * Eigen::Map<const Eigen::Vector3d>(t + 6);
-    }
-    out.col(n) = g;
-  }
+  stencil_.gather(out, [&](std::int64_t cell, int v) {
+    const double* t = terms.data() + 9 * cell;
+    const double sa = (v & 2) ? 1.0 : -1.0;
+    const double sb = (v & 4) ? 1.0 : -1.0;
+    const double sc = (v & 1) ? 1.0 : -1.0;
+    return Eigen::Vector3d(sa * Eigen::Map<const Eigen::Vector3d>(t) +
+                           sb * Eigen::Map<const Eigen::Vector3d>(t + 3) +
+                           sc * Eigen::Map<const Eigen::Vector3d>(t + 6));
+  });
 }
 
 ElasticValue VolumeKernel::evaluate(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,

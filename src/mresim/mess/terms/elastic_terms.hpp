@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "mresim/mess/lattice/lattice.hpp"
+#include "mresim/mess/terms/grid_stencil.hpp"
 #include "mresim/mess/terms/hessian_blocks.hpp"
 
 namespace mresim::mess {
@@ -70,12 +71,12 @@ struct ElasticEnergies {
 // The two elastic kernels, parallelised with OpenMP so that every result is bitwise
 // independent of the thread count: every spring's tension and every cell's volume derivative
 // is computed once into scratch arrays, then every node gathers its own contributions in a
-// fixed order (node -> incident springs or cells, built once). Energies are summed in fixed
-// blocks (fixed_order.hpp). Gradients and Hessian products are ADDED per node in the order
-// g = out.col(n); g += contributions; out.col(n) = g, so a springs pass followed by a volume
-// pass gives the same bits as one fused pass. Not safe for concurrent calls on one object
-// (the scratch arrays are shared); copies are independent. `lattice` must be the one given to
-// the constructor.
+// fixed order (increasing spring or cell index, found by the grid stencils of
+// grid_stencil.hpp). Energies are summed in
+// fixed blocks (fixed_order.hpp). Gradients and Hessian products are ADDED per node in the order g
+// = out.col(n); g += contributions; out.col(n) = g, so a springs pass followed by a volume pass
+// gives the same bits as one fused pass. Not safe for concurrent calls on one object (the scratch
+// arrays are shared); copies are independent. `lattice` must be the one given to the constructor.
 
 struct ElasticValue {
   double energy = 0.0;    // J
@@ -105,9 +106,7 @@ class SpringKernel {
 
  private:
   std::int64_t node_count_ = 0;
-  // Node -> incident springs: entries 2 s + (node is the spring's second end).
-  std::vector<std::int64_t> offsets_;
-  std::vector<std::int32_t> entries_;
+  SpringStencil stencil_;  // node -> incident springs, from the grid
   // Scratch: tension k (l - L)/l per spring, or B (v_j - v_i) (3 per spring).
   mutable std::vector<double> scratch_;
 };
@@ -141,9 +140,7 @@ class VolumeKernel {
   void gather(const std::vector<double>& terms, Eigen::Matrix3Xd& out) const;
 
   std::int64_t node_count_ = 0;
-  // Node -> incident cells: entries 8 c + v (v = the node's local vertex in cell c).
-  std::vector<std::int64_t> offsets_;
-  std::vector<std::int32_t> entries_;
+  CellStencil stencil_;  // node -> the cells holding it, from the grid
   // Scratch: per cell the three vectors t_a, t_b, t_c (see gather).
   mutable std::vector<double> scratch_;
 };
