@@ -19,13 +19,14 @@ SpringStencil::SpringStencil(const lattice::Lattice& lattice) : shape_(lattice.s
   // index: decreasing delta. Two offsets can share a delta on a thin grid (nz = 2), but then
   // at most one of them stays in the box for any node, so their order does not matter.
   std::iota(backward_order_.begin(), backward_order_.end(), 0);
+  std::stable_sort(backward_order_.begin(), backward_order_.end(), [&](int a, int b) {
+    return delta_[static_cast<std::size_t>(a)] > delta_[static_cast<std::size_t>(b)];
+  });
+  // Number of bits set in every 13-bit mask (spring_of's rank of an offset).
   bits_set_.resize(std::size_t{1} << delta_.size());
   for (std::size_t mask = 1; mask < bits_set_.size(); ++mask) {
     bits_set_[mask] = static_cast<std::uint8_t>(bits_set_[mask >> 1U] + (mask & 1U));
   }
-  std::stable_sort(backward_order_.begin(), backward_order_.end(), [&](int a, int b) {
-    return delta_[static_cast<std::size_t>(a)] > delta_[static_cast<std::size_t>(b)];
-  });
 
   // Present offsets per node, and a check that the spring set is numbered as the stencil says.
   const lattice::SpringSet& springs = lattice.springs;
