@@ -7,6 +7,7 @@
 
 #include "mresim/mess/lattice/volume_elements.hpp"
 #include "mresim/mess/system/fixed_order.hpp"
+#include "mresim/mess/terms/elastic_formulas.hpp"
 
 namespace mresim::mess {
 
@@ -80,16 +81,6 @@ void for_each_item(std::int64_t n, Body&& body) {
   for (std::int64_t i = 0; i < n; ++i) body(i);
 }
 
-// element_length * rest_length_factor(kind), indexed by kind (SpringSet::rest_length).
-std::array<double, 3> rest_lengths_by_kind(const lattice::SpringSet& sp) {
-  std::array<double, 3> lengths{};
-  for (const auto kind :
-       {lattice::SpringKind::edge, lattice::SpringKind::face, lattice::SpringKind::body}) {
-    lengths[static_cast<std::size_t>(kind)] = sp.element_length * lattice::rest_length_factor(kind);
-  }
-  return lengths;
-}
-
 // The spring's Hessian block B = k [(1 - L/l) I + (L/l) r^ r^T].
 Eigen::Matrix3d spring_block(const lattice::SpringSet& sp, std::size_t s,
                              const Eigen::Matrix3Xd& x) {
@@ -121,15 +112,15 @@ ElasticValue SpringKernel::evaluate(const lattice::Lattice& lat, const Eigen::Ma
   const bool want_gradient = gradient != nullptr;
   if (want_gradient) scratch_.resize(static_cast<std::size_t>(springs));
   // Rest lengths by kind, the values sp.rest_length(s) gives, looked up without a call.
-  const std::array<double, 3> rest_length = rest_lengths_by_kind(sp);
+  const std::array<double, 3> rest_length = elastic::rest_lengths(sp.element_length);
   // Energy (eq. 4.62) and tension k (l - L)/l (eq. 4.63).
   const auto sums = detail::fixed_order_sums(springs, [&](std::int64_t s) {
     const auto u = static_cast<std::size_t>(s);
     const double l = (x.col(sp.second[u]) - x.col(sp.first[u])).norm();
-    const double stretch = l - rest_length[static_cast<std::size_t>(sp.kind[u])];
-    if (want_gradient) scratch_[u] = sp.stiffness[u] * stretch / l;
-    const double k_stretch = sp.stiffness[u] * stretch;
-    return std::array<double, 2>{0.5 * k_stretch * stretch, std::abs(k_stretch) * l};
+    const elastic::SpringValue value = elastic::spring_value(
+        sp.stiffness[u], rest_length[static_cast<std::size_t>(sp.kind[u])], l);
+    if (want_gradient) scratch_[u] = value.tension;
+    return std::array<double, 2>{value.energy, value.rounding};
   });
   if (gradient == nullptr) return {sums[0], sums[1]};
   // Gather: every node sums its own springs in a fixed order (no races, no atomics).
@@ -145,7 +136,7 @@ void SpringKernel::add_hessian_product(const lattice::Lattice& lat, const Eigen:
   check_shapes("SpringKernel::add_hessian_product", node_count_, lat, x);
   const lattice::SpringSet& sp = lat.springs;
   scratch_.resize(3 * sp.size());
-  const std::array<double, 3> rest_length = rest_lengths_by_kind(sp);
+  const std::array<double, 3> rest_length = elastic::rest_lengths(sp.element_length);
   // w_s = B_s (v_j - v_i) = k [(1 - L/l) dv + (L/l) u (u . dv)], u = r/l, without forming B:
   // +w_s on the second end, -w_s on the first.
   for_each_item(static_cast<std::int64_t>(sp.size()), [&](std::int64_t s) {
@@ -217,13 +208,7 @@ VolumeKernel::VolumeKernel(const lattice::Lattice& lat)
 
 void VolumeKernel::gather(const std::vector<double>& terms, Eigen::Matrix3Xd& out) const {
   stencil_.gather(out, [&](std::int64_t cell, int v) {
-    const double* t = terms.data() + 9 * cell;
-    const double sa = (v & 2) ? 1.0 : -1.0;
-    const double sb = (v & 4) ? 1.0 : -1.0;
-    const double sc = (v & 1) ? 1.0 : -1.0;
-    return Eigen::Vector3d(sa * Eigen::Map<const Eigen::Vector3d>(t) +
-                           sb * Eigen::Map<const Eigen::Vector3d>(t + 3) +
-                           sc * Eigen::Map<const Eigen::Vector3d>(t + 6));
+    return elastic::vertex_gradient(terms.data() + 9 * cell, v);
   });
 }
 
@@ -235,25 +220,13 @@ ElasticValue VolumeKernel::evaluate(const lattice::Lattice& lat, const Eigen::Ma
   const double v0 = std::pow(lat.element_length, 3);
   const bool want_gradient = gradient != nullptr;
   if (want_gradient) scratch_.resize(static_cast<std::size_t>(9 * cells));
-  // Energy (eq. 4.64 x V0) and f (b x c), f (c x a), f (a x b) with
-  // f = factor kappa (V/V0 - 1)/4, so that dU/dx_v = s_a f (b x c) + s_b f (c x a) + s_c f (a x b)
-  // (eqs. 4.66-4.69 with the 1/4 of the averaged edge vectors).
+  // Energy (eq. 4.64 x V0) and the gradient coefficients of every cell (eqs. 4.66-4.69,
+  // elastic::cell_value), then the gather.
   const auto sums = detail::fixed_order_sums(cells, [&](std::int64_t c) {
-    const lattice::EdgeVectors e = lattice::averaged_edge_vectors(
-        gather_vertices(lat.elements[static_cast<std::size_t>(c)], x));
-    const Eigen::Vector3d bxc = e.b.cross(e.c);
-    const double dv = e.a.dot(bxc) / v0 - 1.0;
-    if (want_gradient) {
-      const double f = 0.25 * force_factor * kappa * dv;
-      double* t = scratch_.data() + 9 * c;
-      Eigen::Map<Eigen::Vector3d> t_bc(t);
-      Eigen::Map<Eigen::Vector3d> t_ca(t + 3);
-      Eigen::Map<Eigen::Vector3d> t_ab(t + 6);
-      t_bc = f * bxc;
-      t_ca = f * e.c.cross(e.a);
-      t_ab = f * e.a.cross(e.b);
-    }
-    return std::array<double, 2>{0.5 * kappa * v0 * dv * dv, std::abs(kappa * v0 * dv)};
+    const elastic::CellValue value =
+        elastic::cell_value(gather_vertices(lat.elements[static_cast<std::size_t>(c)], x), kappa,
+                            v0, force_factor, want_gradient ? scratch_.data() + 9 * c : nullptr);
+    return std::array<double, 2>{value.energy, value.rounding};
   });
   if (gradient != nullptr) gather(scratch_, *gradient);
   return {sums[0], sums[1]};

@@ -7,21 +7,30 @@
 
 namespace mresim::mess {
 
+std::array<std::int64_t, 13> forward_offset_deltas(const lattice::GridShape& shape) {
+  std::array<std::int64_t, 13> delta{};
+  for (std::size_t o = 0; o < delta.size(); ++o) {
+    const auto& d = lattice::kForwardNeighbours[o];
+    delta[o] = d[2] + std::int64_t{shape.nz()} * (d[0] + std::int64_t{shape.nx()} * d[1]);
+  }
+  return delta;
+}
+
+std::array<int, 13> backward_offset_order(const std::array<std::int64_t, 13>& deltas) {
+  std::array<int, 13> order{};
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return deltas[static_cast<std::size_t>(a)] > deltas[static_cast<std::size_t>(b)];
+  });
+  return order;
+}
+
 SpringStencil::SpringStencil(const lattice::Lattice& lattice) : shape_(lattice.shape) {
   const int nx = shape_.nx();
   const int ny = shape_.ny();
   const int nz = shape_.nz();
-  for (std::size_t o = 0; o < delta_.size(); ++o) {
-    const auto& d = lattice::kForwardNeighbours[o];
-    delta_[o] = d[2] + std::int64_t{nz} * (d[0] + std::int64_t{nx} * d[1]);
-  }
-  // Backward springs of a node come from lower-index nodes n - delta(o), in increasing node
-  // index: decreasing delta. Two offsets can share a delta on a thin grid (nz = 2), but then
-  // at most one of them stays in the box for any node, so their order does not matter.
-  std::iota(backward_order_.begin(), backward_order_.end(), 0);
-  std::stable_sort(backward_order_.begin(), backward_order_.end(), [&](int a, int b) {
-    return delta_[static_cast<std::size_t>(a)] > delta_[static_cast<std::size_t>(b)];
-  });
+  delta_ = forward_offset_deltas(shape_);
+  backward_order_ = backward_offset_order(delta_);
   // Number of bits set in every 13-bit mask (spring_of's rank of an offset).
   bits_set_.resize(std::size_t{1} << delta_.size());
   for (std::size_t mask = 1; mask < bits_set_.size(); ++mask) {

@@ -36,6 +36,20 @@
 
 namespace mresim::mess {
 
+// Node index change of each forward offset (lattice::kForwardNeighbours) on `shape`'s grid.
+std::array<std::int64_t, 13> forward_offset_deltas(const lattice::GridShape& shape);
+// The forward offsets by decreasing index change: the order in which a node's backward
+// springs (from the lower-index nodes n - delta(o), in increasing index) come. Two offsets can
+// share a delta on a thin grid (nz = 2), but then at most one of them stays in the box for any
+// node, so their order does not matter.
+std::array<int, 13> backward_offset_order(const std::array<std::int64_t, 13>& deltas);
+
+// The up to eight cells of node (ix, iy, iz) are (ix - dx, iy - dy, iz - dz) for these
+// offsets (dx, dy, dz), listed in increasing cell index (lattice::GridShape::cell_index); the
+// node is the cell's local vertex 2 dx + 4 dy + dz (lattice::vertex_offset).
+inline constexpr std::array<std::array<int, 3>, 8> kCellsOfNode = {
+    {{1, 1, 1}, {0, 1, 1}, {1, 0, 1}, {0, 0, 1}, {1, 1, 0}, {0, 1, 0}, {1, 0, 0}, {0, 0, 0}}};
+
 class SpringStencil {
  public:
   SpringStencil() = default;
@@ -117,13 +131,6 @@ class CellStencil {
   void gather(Eigen::Matrix3Xd& out, Contribution&& contribution) const;
 
  private:
-  // The cells (ix - dx, iy - dy, iz - dz) of node (ix, iy, iz) in increasing cell index, and
-  // the node's local vertex in each: offset (dx, dy, dz) is vertex 2 dx + 4 dy + dz
-  // (lattice::vertex_offset).
-  static constexpr std::array<int, 8> kDx = {1, 0, 1, 0, 1, 0, 1, 0};
-  static constexpr std::array<int, 8> kDy = {1, 1, 0, 0, 1, 1, 0, 0};
-  static constexpr std::array<int, 8> kDz = {1, 1, 1, 1, 0, 0, 0, 0};
-
   lattice::GridShape shape_;
 };
 
@@ -146,13 +153,13 @@ void CellStencil::gather(Eigen::Matrix3Xd& out, Contribution&& contribution) con
       const std::int64_t corner_cell = ix + cx * (iy + cy * iz);  // the cell at offset (0, 0, 0)
       Eigen::Vector3d g = out.col(n);
 #pragma GCC unroll 8
-      for (std::size_t k = 0; k < 8; ++k) {
-        if (!inside && (ix - kDx[k] < 0 || ix - kDx[k] >= nx - 1 || iy - kDy[k] < 0 ||
-                        iy - kDy[k] >= ny - 1 || iz - kDz[k] < 0 || iz - kDz[k] >= nz - 1)) {
+      for (const auto& [dx, dy, dz] : kCellsOfNode) {
+        if (!inside && (ix - dx < 0 || ix - dx >= nx - 1 || iy - dy < 0 || iy - dy >= ny - 1 ||
+                        iz - dz < 0 || iz - dz >= nz - 1)) {
           continue;
         }
-        const std::int64_t cell = corner_cell - (kDx[k] + cx * (kDy[k] + cy * kDz[k]));
-        g += contribution(cell, 2 * kDx[k] + 4 * kDy[k] + kDz[k]);
+        const std::int64_t cell = corner_cell - (dx + cx * (dy + cy * dz));
+        g += contribution(cell, 2 * dx + 4 * dy + dz);
       }
       out.col(n) = g;
     }

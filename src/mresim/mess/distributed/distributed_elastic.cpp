@@ -1,0 +1,221 @@
+#include "mresim/mess/distributed/distributed_elastic.hpp"
+
+#include <petscdmda.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "mresim/mess/terms/elastic_formulas.hpp"
+#include "mresim/mess/terms/grid_stencil.hpp"
+
+namespace mresim::mess {
+
+namespace {
+
+using Map3 = Eigen::Map<const Eigen::Vector3d>;
+
+// Per-line partial sums (springs, volume, their rounding scales) added in line order: the same
+// result for any number of threads.
+using Sums = std::array<double, 4>;
+
+Sums add_in_order(const std::vector<Sums>& lines) {
+  Sums total{};
+  for (const Sums& s : lines) {
+    for (std::size_t k = 0; k < total.size(); ++k) total[k] += s[k];
+  }
+  return total;
+}
+
+// The cells with a vertex in `owned`: cell corners from one below the owned box to its upper
+// end, clipped to the lattice's cells.
+NodeBox cells_touching(const NodeBox& owned, const lattice::GridShape& shape) {
+  NodeBox cells;
+  const std::array<int, 3> cell_count = shape.cells();
+  for (std::size_t a = 0; a < 3; ++a) {
+    const int lower = std::max(owned.lower[a] - 1, 0);
+    const int upper = std::min(owned.lower[a] + owned.size[a], cell_count[a]);
+    cells.lower[a] = lower;
+    cells.size[a] = std::max(upper - lower, 0);
+  }
+  return cells;
+}
+
+}  // namespace
+
+DistributedElastic::DistributedElastic(const lattice::Lattice& lattice,
+                                       const LatticeDecomposition& decomposition,
+                                       double volume_force_factor)
+    : decomposition_(decomposition),
+      kappa_(lattice.polymer.kappa),
+      cell_volume_(std::pow(lattice.element_length, 3)),
+      volume_factor_(volume_force_factor) {
+  const std::array<double, 3> rest_length = elastic::rest_lengths(lattice.element_length);
+  for (std::size_t o = 0; o < rest_length_of_offset_.size(); ++o) {
+    rest_length_of_offset_[o] = rest_length[static_cast<std::size_t>(
+        lattice::kind_of_offset(lattice::kForwardNeighbours[o]))];
+  }
+  const lattice::GridShape& shape = lattice.shape;
+  if (shape.nodes != decomposition.shape().nodes) {
+    throw std::invalid_argument(
+        "DistributedElastic: the decomposition is not of the lattice's grid");
+  }
+  if (!(volume_force_factor > 0.0)) {
+    throw std::invalid_argument("DistributedElastic: volume_force_factor must be > 0, got " +
+                                std::to_string(volume_force_factor));
+  }
+  delta_ = forward_offset_deltas(shape);
+  backward_order_ = backward_offset_order(delta_);
+
+  // The stiffness of every forward spring of a ghosted node, as a class byte.
+  const NodeBox& ghosted = decomposition.ghosted();
+  spring_class_.assign(static_cast<std::size_t>(13 * ghosted.node_count()), kNoSpring);
+  const lattice::SpringSet& springs = lattice.springs;
+  for (std::size_t s = 0; s < springs.size(); ++s) {
+    const std::array<int, 3> first = shape.node_coordinates(springs.first[s]);
+    if (!ghosted.contains(first[0], first[1], first[2])) continue;
+    const std::array<int, 3> second = shape.node_coordinates(springs.second[s]);
+    const std::array<int, 3> step = {second[0] - first[0], second[1] - first[1],
+                                     second[2] - first[2]};
+    const auto offset =
+        std::find(lattice::kForwardNeighbours.begin(), lattice::kForwardNeighbours.end(), step);
+    if (offset == lattice::kForwardNeighbours.end()) {
+      throw std::invalid_argument("DistributedElastic: spring " + std::to_string(s) +
+                                  " does not join forward neighbours");
+    }
+    const double k = springs.stiffness[s];
+    auto known = std::find(stiffness_.begin(), stiffness_.end(), k);
+    if (known == stiffness_.end()) {
+      if (stiffness_.size() == kNoSpring) {
+        throw std::invalid_argument("DistributedElastic: more than 255 distinct spring constants");
+      }
+      stiffness_.push_back(k);
+      known = stiffness_.end() - 1;
+    }
+    const auto o = offset - lattice::kForwardNeighbours.begin();
+    spring_class_[static_cast<std::size_t>(13 * ghosted.offset(first[0], first[1], first[2]) + o)] =
+        static_cast<std::uint8_t>(known - stiffness_.begin());
+  }
+  check_petsc(DMCreateLocalVector(decomposition.dm(), &local_), "DMCreateLocalVector");
+}
+
+DistributedElastic::~DistributedElastic() { (void)VecDestroy(&local_); }
+
+ElasticEnergies DistributedElastic::evaluate(Vec positions, Vec gradient) const {
+  const LatticeDecomposition& d = decomposition_;
+  const lattice::GridShape& shape = d.shape();
+  const int nx = shape.nx();
+  const int ny = shape.ny();
+  const int nz = shape.nz();
+  const NodeBox& owned = d.owned();
+  const NodeBox& ghosted = d.ghosted();
+  check_petsc(DMGlobalToLocalBegin(d.dm(), positions, INSERT_VALUES, local_),
+              "DMGlobalToLocalBegin");
+  check_petsc(DMGlobalToLocalEnd(d.dm(), positions, INSERT_VALUES, local_), "DMGlobalToLocalEnd");
+  const PetscScalar* x = nullptr;
+  check_petsc(VecGetArrayRead(local_, &x), "VecGetArrayRead");
+  const auto at = [&](int ix, int iy, int iz) { return Map3(x + 3 * ghosted.offset(ix, iy, iz)); };
+
+  // Cells: energy of the owned ones (lower corner owned), gradient coefficients of all that
+  // touch an owned node. Lines along z, as the nodes.
+  const NodeBox cells = cells_touching(owned, shape);
+  const bool want_gradient = gradient != nullptr;
+  if (want_gradient) cell_terms_.resize(static_cast<std::size_t>(9 * cells.node_count()));
+  const std::int64_t cell_lines = std::int64_t{cells.size[0]} * cells.size[1];
+  std::vector<Sums> cell_sums(static_cast<std::size_t>(cell_lines), Sums{});
+#pragma omp parallel for schedule(static)
+  for (std::int64_t line = 0; line < cell_lines; ++line) {
+    const int cx = cells.lower[0] + static_cast<int>(line % cells.size[0]);
+    const int cy = cells.lower[1] + static_cast<int>(line / cells.size[0]);
+    Sums& sums = cell_sums[static_cast<std::size_t>(line)];
+    for (int cz = cells.lower[2]; cz < cells.lower[2] + cells.size[2]; ++cz) {
+      const bool counted = owned.contains(cx, cy, cz);
+      if (!counted && !want_gradient) continue;
+      lattice::CellVertices vertices;
+      for (int v = 0; v < 8; ++v) {
+        const std::array<int, 3> o = lattice::vertex_offset(v);
+        vertices[static_cast<std::size_t>(v)] = at(cx + o[0], cy + o[1], cz + o[2]);
+      }
+      double* t = want_gradient ? cell_terms_.data() + 9 * cells.offset(cx, cy, cz) : nullptr;
+      const elastic::CellValue value =
+          elastic::cell_value(vertices, kappa_, cell_volume_, volume_factor_, t);
+      if (counted) {
+        sums[1] += value.energy;
+        sums[3] += value.rounding;
+      }
+    }
+  }
+
+  // Nodes: each owned node's springs in increasing spring index (backward, then forward) and
+  // then its cells in increasing cell index, as SpringStencil and CellStencil gather them. The
+  // energy of the springs it owns (its forward ones).
+  PetscScalar* g = nullptr;
+  if (want_gradient) check_petsc(VecGetArray(gradient, &g), "VecGetArray");
+  const std::int64_t lines = std::int64_t{owned.size[0]} * owned.size[1];
+  std::vector<Sums> node_sums(static_cast<std::size_t>(lines), Sums{});
+  const auto in_lattice = [&](int ix, int iy, int iz) {
+    return ix >= 0 && ix < nx && iy >= 0 && iy < ny && iz >= 0 && iz < nz;
+  };
+#pragma omp parallel for schedule(static)
+  for (std::int64_t line = 0; line < lines; ++line) {
+    const int ix = owned.lower[0] + static_cast<int>(line % owned.size[0]);
+    const int iy = owned.lower[1] + static_cast<int>(line / owned.size[0]);
+    Sums& sums = node_sums[static_cast<std::size_t>(line)];
+    for (int iz = owned.lower[2]; iz < owned.lower[2] + owned.size[2]; ++iz) {
+      const Map3 xn = at(ix, iy, iz);
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      if (want_gradient) {
+        for (const int o : backward_order_) {
+          const auto& step = lattice::kForwardNeighbours[static_cast<std::size_t>(o)];
+          const int mx = ix - step[0];
+          const int my = iy - step[1];
+          const int mz = iz - step[2];
+          if (!in_lattice(mx, my, mz)) continue;
+          const std::uint8_t k =
+              spring_class_[static_cast<std::size_t>(13 * ghosted.offset(mx, my, mz) + o)];
+          const Eigen::Vector3d r = xn - at(mx, my, mz);
+          const elastic::SpringValue value = elastic::spring_value(
+              stiffness_[k], rest_length_of_offset_[static_cast<std::size_t>(o)], r.norm());
+          sum += Eigen::Vector3d(value.tension * r);
+        }
+      }
+      const std::int64_t self = 13 * ghosted.offset(ix, iy, iz);
+      for (int o = 0; o < 13; ++o) {
+        const std::uint8_t k = spring_class_[static_cast<std::size_t>(self + o)];
+        if (k == kNoSpring) continue;
+        const auto& step = lattice::kForwardNeighbours[static_cast<std::size_t>(o)];
+        const Eigen::Vector3d r = at(ix + step[0], iy + step[1], iz + step[2]) - xn;
+        const elastic::SpringValue value = elastic::spring_value(
+            stiffness_[k], rest_length_of_offset_[static_cast<std::size_t>(o)], r.norm());
+        sum -= Eigen::Vector3d(value.tension * r);
+        sums[0] += value.energy;
+        sums[2] += value.rounding;
+      }
+      if (!want_gradient) continue;
+      for (const auto& [dx, dy, dz] : kCellsOfNode) {
+        const int cx = ix - dx;
+        const int cy = iy - dy;
+        const int cz = iz - dz;
+        if (cx < 0 || cx >= nx - 1 || cy < 0 || cy >= ny - 1 || cz < 0 || cz >= nz - 1) continue;
+        sum += elastic::vertex_gradient(cell_terms_.data() + 9 * cells.offset(cx, cy, cz),
+                                        2 * dx + 4 * dy + dz);
+      }
+      Eigen::Map<Eigen::Vector3d>(g + 3 * owned.offset(ix, iy, iz)) = sum;
+    }
+  }
+  if (want_gradient) check_petsc(VecRestoreArray(gradient, &g), "VecRestoreArray");
+  check_petsc(VecRestoreArrayRead(local_, &x), "VecRestoreArrayRead");
+
+  const Sums cell_total = add_in_order(cell_sums);
+  const Sums node_total = add_in_order(node_sums);
+  Sums local{node_total[0], cell_total[1], node_total[2], cell_total[3]};
+  Sums total{};
+  if (MPI_Allreduce(local.data(), total.data(), static_cast<int>(total.size()), MPI_DOUBLE, MPI_SUM,
+                    d.comm()) != MPI_SUCCESS) {
+    throw std::runtime_error("DistributedElastic: MPI_Allreduce failed");
+  }
+  return {total[0], total[1], total[2], total[3]};
+}
+
+}  // namespace mresim::mess

@@ -1,0 +1,70 @@
+#pragma once
+
+// The elastic terms of the 3D model (springs, eq. 4.62, and volume, eq. 4.64 x V0) evaluated
+// over a LatticeDecomposition: each process computes the energy of the springs and cells it
+// owns and the gradient at its own nodes, from its nodes' and the ghost layer's positions
+// (PETSc's DMGlobalToLocal brings in the ghosts). The energies are summed over the processes
+// (MPI_Allreduce).
+//
+// Same numbers as one process. Every node gathers its springs and cells in the order of the
+// single-process kernels (terms/grid_stencil.hpp: increasing spring and cell index) with the
+// same per-spring and per-cell formulas (terms/elastic_formulas.hpp), so the gradient is
+// bitwise ElasticTerms::evaluate's on any number of processes and threads. Each spring's
+// tension is computed at both of its ends (no per-spring scratch array). The energies are
+// summed in another order (per grid line, then over processes), so they agree with the
+// single-process sums to rounding (relative 1e-15 or so), not bitwise.
+//
+// Memory per process: one byte per forward spring of its ghosted nodes (the spring's stiffness
+// as an index into a table of the lattice's distinct spring constants), 72 bytes per cell
+// touching its nodes (gradient coefficients), and PETSc's ghosted position vector. The set-up
+// reads the whole lattice, which every process builds today (docs/mpi.md: what is distributed
+// so far and what is next).
+
+#include <petscvec.h>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "mresim/mess/distributed/lattice_decomposition.hpp"
+#include "mresim/mess/lattice/lattice.hpp"
+#include "mresim/mess/terms/elastic_terms.hpp"
+
+namespace mresim::mess {
+
+class DistributedElastic {
+ public:
+  // `decomposition` must outlive this object and be of `lattice`'s grid; `lattice.springs`
+  // must be the forward-neighbour set of build_springs (as for SpringStencil). Collective.
+  DistributedElastic(const lattice::Lattice& lattice, const LatticeDecomposition& decomposition,
+                     double volume_force_factor);
+  DistributedElastic(const DistributedElastic&) = delete;
+  DistributedElastic& operator=(const DistributedElastic&) = delete;
+  DistributedElastic(DistributedElastic&&) = delete;
+  DistributedElastic& operator=(DistributedElastic&&) = delete;
+  ~DistributedElastic();
+
+  // Collective. `positions`: a global vector of the decomposition (m). If `gradient` is not
+  // null, it (a global vector too) is overwritten with d(springs)/dx + volume_force_factor
+  // d(volume)/dx at the owned nodes (J/m). The energies are the totals over all processes.
+  ElasticEnergies evaluate(Vec positions, Vec gradient) const;
+
+ private:
+  static constexpr std::uint8_t kNoSpring = 255;
+
+  const LatticeDecomposition& decomposition_;
+  double kappa_ = 0.0;                              // J/m^3
+  double cell_volume_ = 0.0;                        // V0 = l_e^3
+  double volume_factor_ = 1.0;                      // volume_force_factor
+  std::array<double, 13> rest_length_of_offset_{};  // by forward offset
+  std::array<std::int64_t, 13> delta_{};            // node index change of each forward offset
+  std::array<int, 13> backward_order_{};            // offsets by decreasing delta
+  std::vector<double> stiffness_;                   // the distinct spring constants (N/m)
+  // Per ghosted node (NodeBox::offset of the ghosted box) and forward offset: index into
+  // stiffness_, or kNoSpring where the neighbour is outside the lattice.
+  std::vector<std::uint8_t> spring_class_;
+  Vec local_ = nullptr;                     // positions of the ghosted box
+  mutable std::vector<double> cell_terms_;  // 9 per cell touching an owned node
+};
+
+}  // namespace mresim::mess
