@@ -154,52 +154,71 @@ ElasticEnergies DistributedElastic::evaluate(Vec positions, Vec gradient) const 
   if (want_gradient) check_petsc(VecGetArray(gradient, &g), "VecGetArray");
   const std::int64_t lines = std::int64_t{owned.size[0]} * owned.size[1];
   std::vector<Sums> node_sums(static_cast<std::size_t>(lines), Sums{});
-  const auto in_lattice = [&](int ix, int iy, int iz) {
-    return ix >= 0 && ix < nx && iy >= 0 && iy < ny && iz >= 0 && iz < nz;
-  };
+  // Index steps of the forward offsets in the ghosted box and of a node's cells in the cell
+  // box, for the nodes away from the lattice's faces (all their springs and cells exist).
+  std::array<std::int64_t, 13> ghosted_step{};
+  for (std::size_t o = 0; o < ghosted_step.size(); ++o) {
+    const auto& step = lattice::kForwardNeighbours[o];
+    ghosted_step[o] = ghosted.offset(ghosted.lower[0] + step[0], ghosted.lower[1] + step[1],
+                                     ghosted.lower[2] + step[2]);
+  }
+  std::array<std::int64_t, 8> cell_step{};
+  for (std::size_t k = 0; k < cell_step.size(); ++k) {
+    const auto& [dx, dy, dz] = kCellsOfNode[k];
+    cell_step[k] = cells.offset(cells.lower[0] + dx, cells.lower[1] + dy, cells.lower[2] + dz);
+  }
 #pragma omp parallel for schedule(static)
   for (std::int64_t line = 0; line < lines; ++line) {
     const int ix = owned.lower[0] + static_cast<int>(line % owned.size[0]);
     const int iy = owned.lower[1] + static_cast<int>(line / owned.size[0]);
     Sums& sums = node_sums[static_cast<std::size_t>(line)];
     for (int iz = owned.lower[2]; iz < owned.lower[2] + owned.size[2]; ++iz) {
-      const Map3 xn = at(ix, iy, iz);
+      const bool inside = ix > 0 && ix < nx - 1 && iy > 0 && iy < ny - 1 && iz > 0 && iz < nz - 1;
+      const std::int64_t self = ghosted.offset(ix, iy, iz);
+      const Map3 xn(x + 3 * self);
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
       if (want_gradient) {
         for (const int o : backward_order_) {
-          const auto& step = lattice::kForwardNeighbours[static_cast<std::size_t>(o)];
-          const int mx = ix - step[0];
-          const int my = iy - step[1];
-          const int mz = iz - step[2];
-          if (!in_lattice(mx, my, mz)) continue;
-          const std::uint8_t k =
-              spring_class_[static_cast<std::size_t>(13 * ghosted.offset(mx, my, mz) + o)];
-          const Eigen::Vector3d r = xn - at(mx, my, mz);
-          const elastic::SpringValue value = elastic::spring_value(
-              stiffness_[k], rest_length_of_offset_[static_cast<std::size_t>(o)], r.norm());
+          const auto u = static_cast<std::size_t>(o);
+          const auto& step = lattice::kForwardNeighbours[u];
+          if (!inside && (ix - step[0] < 0 || ix - step[0] >= nx || iy - step[1] < 0 ||
+                          iy - step[1] >= ny || iz - step[2] < 0 || iz - step[2] >= nz)) {
+            continue;
+          }
+          const std::int64_t m = self - ghosted_step[u];
+          const std::uint8_t k = spring_class_[static_cast<std::size_t>(13 * m + o)];
+          const Eigen::Vector3d r = xn - Map3(x + 3 * m);
+          const elastic::SpringValue value =
+              elastic::spring_value(stiffness_[k], rest_length_of_offset_[u], r.norm());
           sum += Eigen::Vector3d(value.tension * r);
         }
       }
-      const std::int64_t self = 13 * ghosted.offset(ix, iy, iz);
-      for (int o = 0; o < 13; ++o) {
-        const std::uint8_t k = spring_class_[static_cast<std::size_t>(self + o)];
+      for (std::size_t o = 0; o < 13; ++o) {
+        const std::uint8_t k = spring_class_[static_cast<std::size_t>(13 * self) + o];
         if (k == kNoSpring) continue;
-        const auto& step = lattice::kForwardNeighbours[static_cast<std::size_t>(o)];
-        const Eigen::Vector3d r = at(ix + step[0], iy + step[1], iz + step[2]) - xn;
-        const elastic::SpringValue value = elastic::spring_value(
-            stiffness_[k], rest_length_of_offset_[static_cast<std::size_t>(o)], r.norm());
+        const Eigen::Vector3d r = Map3(x + 3 * (self + ghosted_step[o])) - xn;
+        const elastic::SpringValue value =
+            elastic::spring_value(stiffness_[k], rest_length_of_offset_[o], r.norm());
         sum -= Eigen::Vector3d(value.tension * r);
         sums[0] += value.energy;
         sums[2] += value.rounding;
       }
       if (!want_gradient) continue;
-      for (const auto& [dx, dy, dz] : kCellsOfNode) {
-        const int cx = ix - dx;
-        const int cy = iy - dy;
-        const int cz = iz - dz;
-        if (cx < 0 || cx >= nx - 1 || cy < 0 || cy >= ny - 1 || cz < 0 || cz >= nz - 1) continue;
-        sum += elastic::vertex_gradient(cell_terms_.data() + 9 * cells.offset(cx, cy, cz),
-                                        2 * dx + 4 * dy + dz);
+      const std::int64_t corner_cell =
+          cells.contains(ix, iy, iz) ? cells.offset(ix, iy, iz) : -1;  // the cell at (0, 0, 0)
+      for (std::size_t c = 0; c < kCellsOfNode.size(); ++c) {
+        const auto& [dx, dy, dz] = kCellsOfNode[c];
+        std::int64_t cell = 0;
+        if (inside) {
+          cell = corner_cell - cell_step[c];
+        } else {
+          const int cx = ix - dx;
+          const int cy = iy - dy;
+          const int cz = iz - dz;
+          if (cx < 0 || cx >= nx - 1 || cy < 0 || cy >= ny - 1 || cz < 0 || cz >= nz - 1) continue;
+          cell = cells.offset(cx, cy, cz);
+        }
+        sum += elastic::vertex_gradient(cell_terms_.data() + 9 * cell, 2 * dx + 4 * dy + dz);
       }
       Eigen::Map<Eigen::Vector3d>(g + 3 * owned.offset(ix, iy, iz)) = sum;
     }
