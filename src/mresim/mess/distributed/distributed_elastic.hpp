@@ -49,6 +49,8 @@ class DistributedElastic {
   // d(volume)/dx at the owned nodes (J/m). The energies are the totals over all processes.
   ElasticEnergies evaluate(Vec positions, Vec gradient) const;
 
+  [[nodiscard]] double volume_force_factor() const { return volume_factor_; }
+
  private:
   static constexpr std::uint8_t kNoSpring = 255;
 

@@ -159,7 +159,14 @@ Eigen::Matrix3Xd MessSystem::particle_bounding_box_centres() const {
 }
 
 const mm::MagnetizationResult& MessSystem::solve_magnetization() {
-  const Eigen::Matrix3Xd centres = particle_centres();
+  return solve_magnetization_at(particle_centres());
+}
+
+const mm::MagnetizationResult& MessSystem::solve_magnetization_at(const Eigen::Matrix3Xd& centres) {
+  if (centres.cols() != static_cast<Eigen::Index>(lattice_.particle_count())) {
+    throw std::invalid_argument(
+        "MessSystem::solve_magnetization_at: expected one column per particle");
+  }
   if (centres.cols() == 0) {
     stats_.last = mm::MagnetizationResult{};
     stats_.last.converged = true;
@@ -183,20 +190,28 @@ const mm::MagnetizationResult& MessSystem::solve_magnetization() {
 }
 
 void MessSystem::maybe_update_magnetization() {
+  if (lattice_.particle_count() == 0 ||
+      settings_.magnetization_update == MagnetizationUpdate::manual) {
+    return;
+  }
+  update_magnetization_at(particle_centres());
+}
+
+void MessSystem::update_magnetization_at(const Eigen::Matrix3Xd& centres) {
   if (lattice_.particle_count() == 0) return;
   switch (settings_.magnetization_update) {
     case MagnetizationUpdate::manual:
       return;
     case MagnetizationUpdate::every_evaluation:
-      (void)solve_magnetization();
+      (void)solve_magnetization_at(centres);
       return;
     case MagnetizationUpdate::on_displacement: {
       bool needed = field_changed_ || last_solve_centres_.cols() != M_.cols();
       if (!needed) {
-        const double moved = (particle_centres() - last_solve_centres_).colwise().norm().maxCoeff();
+        const double moved = (centres - last_solve_centres_).colwise().norm().maxCoeff();
         needed = moved > settings_.resolve_distance * lattice_.element_length;
       }
-      if (needed) (void)solve_magnetization();
+      if (needed) (void)solve_magnetization_at(centres);
       return;
     }
   }
@@ -247,41 +262,51 @@ void spread_centre_terms(const lattice::Lattice& lat, const Eigen::Matrix3Xd& gc
 
 }  // namespace
 
+Evaluation evaluation_from_terms(const std::vector<std::unique_ptr<EnergyTerm>>& terms,
+                                 const std::shared_ptr<const TermLabels>& labels,
+                                 const std::vector<TermValue>& values, const TermState& state) {
+  Evaluation out;
+  out.energies = MessEnergies(labels);
+  // The magnitude is one sum in list order: first every rounding scale, then every |E|,
+  // each times its force factor (the order of the fixed fields before the term list).
+  double magnitude = 0.0;
+  double extra = 0.0;  // sum (force_factor - 1) E over the terms whose factor is not 1
+  std::vector<double> factors(terms.size(), 0.0);
+  for (std::size_t i = 0; i < terms.size(); ++i) {
+    const EnergyTerm& t = *terms[i];
+    out.energies.value(i) = values[i].energy;
+    if (!t.in_total()) continue;
+    factors[i] = t.force_factor(state);
+    magnitude += factors[i] * values[i].rounding;
+    // Never (1 - 1) x inf: the self-energy may be +inf.
+    if (factors[i] != 1.0) extra += (factors[i] - 1.0) * values[i].energy;
+  }
+  for (std::size_t i = 0; i < terms.size(); ++i) {
+    if (terms[i]->in_total()) magnitude += factors[i] * std::abs(out.energies.value(i));
+  }
+  out.potential = extra == 0.0 ? out.energies.total() : out.energies.total() + extra;
+  out.magnitude = magnitude;
+  return out;
+}
+
 Evaluation MessSystem::evaluate(Eigen::Matrix3Xd* gradient) {
   if (!(settings_.elastic.volume_force_factor > 0.0)) {
     throw std::invalid_argument("MessSystem: volume_force_factor must be > 0");
   }
   maybe_update_magnetization();
   return with_state([&](const TermState& state) {
-    Evaluation out;
-    out.energies = MessEnergies(labels_);
     TermGradient g;
     if (gradient != nullptr) {
       g.nodes = std::move(*gradient);  // reuse the caller's storage
       g.nodes.setZero(3, lattice_.node_count());
       g.centres.setZero(3, state.centres.cols());
     }
-    // The magnitude is one sum in list order: first every rounding scale, then every |E|,
-    // each times its force factor (the order of the fixed fields before the term list).
-    double magnitude = 0.0;
-    double extra = 0.0;  // sum (force_factor - 1) E over the terms whose factor is not 1
-    std::vector<double> factors(terms_.size(), 0.0);
+    std::vector<TermValue> values(terms_.size());
     for (std::size_t i = 0; i < terms_.size(); ++i) {
       const EnergyTerm& t = *terms_[i];
-      const bool counted = t.in_total();
-      const TermValue v = t.evaluate(state, counted && gradient != nullptr ? &g : nullptr);
-      out.energies.value(i) = v.energy;
-      if (!counted) continue;
-      factors[i] = t.force_factor(state);
-      magnitude += factors[i] * v.rounding;
-      // Never (1 - 1) x inf: the self-energy may be +inf.
-      if (factors[i] != 1.0) extra += (factors[i] - 1.0) * v.energy;
+      values[i] = t.evaluate(state, t.in_total() && gradient != nullptr ? &g : nullptr);
     }
-    for (std::size_t i = 0; i < terms_.size(); ++i) {
-      if (terms_[i]->in_total()) magnitude += factors[i] * std::abs(out.energies.value(i));
-    }
-    out.potential = extra == 0.0 ? out.energies.total() : out.energies.total() + extra;
-    out.magnitude = magnitude;
+    Evaluation out = evaluation_from_terms(terms_, labels_, values, state);
     if (gradient != nullptr) {
       spread_centre_terms(lattice_, g.centres, g.nodes);
       *gradient = std::move(g.nodes);

@@ -74,6 +74,13 @@ struct MagnetizationStats {
   magnetism::MagnetizationResult last;      // the latest solve's full diagnostics
 };
 
+// The energies, potential and magnitude of one evaluation from every term's value (in list
+// order, reported-only terms included): MessSystem::evaluate's bookkeeping, shared with the
+// distributed evaluation (distributed/distributed_system.hpp). `state` gives the force factors.
+Evaluation evaluation_from_terms(const std::vector<std::unique_ptr<EnergyTerm>>& terms,
+                                 const std::shared_ptr<const TermLabels>& labels,
+                                 const std::vector<TermValue>& values, const TermState& state);
+
 class MessSystem {
  public:
   // Throws std::invalid_argument if the model's particle radius is not the lattice's or the
@@ -142,6 +149,11 @@ class MessSystem {
 
   // Re-solves M now at the current positions from the current M (history).
   const magnetism::MagnetizationResult& solve_magnetization();
+  // The same at the given particle centres (3 x N_p, m) instead of those of positions(): for an
+  // evaluation whose positions live elsewhere (distributed/distributed_system.hpp).
+  const magnetism::MagnetizationResult& solve_magnetization_at(const Eigen::Matrix3Xd& centres);
+  // evaluate()'s update rule for M (settings().magnetization_update) at the given centres.
+  void update_magnetization_at(const Eigen::Matrix3Xd& centres);
   const MagnetizationStats& magnetization_stats() const { return stats_; }
 
   // Energies at the current positions and M (no re-solve).
