@@ -16,10 +16,9 @@ namespace {
 
 using Map3 = Eigen::Map<const Eigen::Vector3d>;
 
-// Per-line partial sums (springs, volume, their rounding scales) added in line order: the same
-// result for any number of threads.
 using Sums = std::array<double, 4>;
 
+// Per-line partial sums added in line order: the same result for any number of threads.
 Sums add_in_order(const std::vector<Sums>& lines) {
   Sums total{};
   for (const Sums& s : lines) {
@@ -104,23 +103,38 @@ DistributedElastic::~DistributedElastic() { (void)VecDestroy(&local_); }
 
 ElasticEnergies DistributedElastic::evaluate(Vec positions, Vec gradient) const {
   const LatticeDecomposition& d = decomposition_;
-  const lattice::GridShape& shape = d.shape();
-  const int nx = shape.nx();
-  const int ny = shape.ny();
-  const int nz = shape.nz();
-  const NodeBox& owned = d.owned();
-  const NodeBox& ghosted = d.ghosted();
   check_petsc(DMGlobalToLocalBegin(d.dm(), positions, INSERT_VALUES, local_),
               "DMGlobalToLocalBegin");
   check_petsc(DMGlobalToLocalEnd(d.dm(), positions, INSERT_VALUES, local_), "DMGlobalToLocalEnd");
   const PetscScalar* x = nullptr;
   check_petsc(VecGetArrayRead(local_, &x), "VecGetArrayRead");
+  const NodeBox cells = cells_touching(d.owned(), d.shape());
+  const bool want_gradient = gradient != nullptr;
+  const Sums cell_total = evaluate_cells(x, cells, want_gradient);
+  PetscScalar* g = nullptr;
+  if (want_gradient) check_petsc(VecGetArray(gradient, &g), "VecGetArray");
+  const Sums node_total = evaluate_nodes(x, cells, g);
+  if (want_gradient) check_petsc(VecRestoreArray(gradient, &g), "VecRestoreArray");
+  check_petsc(VecRestoreArrayRead(local_, &x), "VecRestoreArrayRead");
+
+  const Sums local{node_total[0], cell_total[1], node_total[2], cell_total[3]};
+  Sums total{};
+  if (MPI_Allreduce(local.data(), total.data(), static_cast<int>(total.size()), MPI_DOUBLE, MPI_SUM,
+                    d.comm()) != MPI_SUCCESS) {
+    throw std::runtime_error("DistributedElastic: MPI_Allreduce failed");
+  }
+  return {total[0], total[1], total[2], total[3]};
+}
+
+DistributedElastic::Sums DistributedElastic::evaluate_cells(const PetscScalar* x,
+                                                            const NodeBox& cells,
+                                                            bool want_gradient) const {
+  const NodeBox& owned = decomposition_.owned();
+  const NodeBox& ghosted = decomposition_.ghosted();
   const auto at = [&](int ix, int iy, int iz) { return Map3(x + 3 * ghosted.offset(ix, iy, iz)); };
 
   // Cells: energy of the owned ones (lower corner owned), gradient coefficients of all that
   // touch an owned node. Lines along z, as the nodes.
-  const NodeBox cells = cells_touching(owned, shape);
-  const bool want_gradient = gradient != nullptr;
   if (want_gradient) cell_terms_.resize(static_cast<std::size_t>(9 * cells.node_count()));
   const std::int64_t cell_lines = std::int64_t{cells.size[0]} * cells.size[1];
   std::vector<Sums> cell_sums(static_cast<std::size_t>(cell_lines), Sums{});
@@ -146,12 +160,23 @@ ElasticEnergies DistributedElastic::evaluate(Vec positions, Vec gradient) const 
       }
     }
   }
+  return add_in_order(cell_sums);
+}
+
+DistributedElastic::Sums DistributedElastic::evaluate_nodes(const PetscScalar* x,
+                                                            const NodeBox& cells,
+                                                            PetscScalar* g) const {
+  const lattice::GridShape& shape = decomposition_.shape();
+  const int nx = shape.nx();
+  const int ny = shape.ny();
+  const int nz = shape.nz();
+  const NodeBox& owned = decomposition_.owned();
+  const NodeBox& ghosted = decomposition_.ghosted();
+  const bool want_gradient = g != nullptr;
 
   // Nodes: each owned node's springs in increasing spring index (backward, then forward) and
   // then its cells in increasing cell index, as SpringStencil and CellStencil gather them. The
   // energy of the springs it owns (its forward ones).
-  PetscScalar* g = nullptr;
-  if (want_gradient) check_petsc(VecGetArray(gradient, &g), "VecGetArray");
   const std::int64_t lines = std::int64_t{owned.size[0]} * owned.size[1];
   std::vector<Sums> node_sums(static_cast<std::size_t>(lines), Sums{});
   // Index steps of the forward offsets in the ghosted box and of a node's cells in the cell
@@ -223,18 +248,7 @@ ElasticEnergies DistributedElastic::evaluate(Vec positions, Vec gradient) const 
       Eigen::Map<Eigen::Vector3d>(g + 3 * owned.offset(ix, iy, iz)) = sum;
     }
   }
-  if (want_gradient) check_petsc(VecRestoreArray(gradient, &g), "VecRestoreArray");
-  check_petsc(VecRestoreArrayRead(local_, &x), "VecRestoreArrayRead");
-
-  const Sums cell_total = add_in_order(cell_sums);
-  const Sums node_total = add_in_order(node_sums);
-  Sums local{node_total[0], cell_total[1], node_total[2], cell_total[3]};
-  Sums total{};
-  if (MPI_Allreduce(local.data(), total.data(), static_cast<int>(total.size()), MPI_DOUBLE, MPI_SUM,
-                    d.comm()) != MPI_SUCCESS) {
-    throw std::runtime_error("DistributedElastic: MPI_Allreduce failed");
-  }
-  return {total[0], total[1], total[2], total[3]};
+  return add_in_order(node_sums);
 }
 
 }  // namespace mresim::mess

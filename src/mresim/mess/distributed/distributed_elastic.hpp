@@ -53,6 +53,15 @@ class DistributedElastic {
 
  private:
   static constexpr std::uint8_t kNoSpring = 255;
+  // Springs, volume and their rounding scales (ElasticEnergies' order) of one process.
+  using Sums = std::array<double, 4>;
+
+  // The cells touching the owned nodes (`cells`, from the ghosted positions x): the energy of
+  // the owned ones (lower corner owned) and, if asked, every one's gradient coefficients.
+  Sums evaluate_cells(const PetscScalar* x, const NodeBox& cells, bool want_gradient) const;
+  // The owned nodes: the energy of their forward springs and, if g is not null, the gradient
+  // (springs, then cells) at each.
+  Sums evaluate_nodes(const PetscScalar* x, const NodeBox& cells, PetscScalar* g) const;
 
   const LatticeDecomposition& decomposition_;
   double kappa_ = 0.0;                              // J/m^3
