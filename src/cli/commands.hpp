@@ -9,6 +9,7 @@
 #include "mresim/app/run_type.hpp"
 #include "mresim/config/table_reader.hpp"
 #include "mresim/io/run_directory.hpp"
+#include "mresim/mess/distributed/mpi_job.hpp"
 
 namespace mresim::cli {
 
@@ -42,9 +43,14 @@ int run_command(const RunOptions& options);
 // Shared by run and resume: executes the plan into run_dir's staging directory (results.h5
 // with the run's metadata), commits it and draws the figures. Returns the exit status; a stop
 // signal (stop_signal.hpp) ends it with 128 + the signal after keeping any checkpoint.
+// `job`: the MPI job of `mpirun -np P mresim run` (rank 0 calls this; docs/mpi.md).
 int execute_and_publish(const config::TableReader& root, const app::RunPlan& plan,
                         const std::string& run_type, io::RunDirectory& run_dir, long threads_option,
-                        bool no_plot);
+                        bool no_plot, const mess::MpiJob& job = {});
+
+// Commands that cannot run over MPI processes yet (resume, extend, rerun) call this first:
+// under mpirun with more than one process it throws std::invalid_argument naming `command`.
+void refuse_mpi_job(const char* command);
 
 // A run with --set overrides keeps them and the run file as written in this file of its staging
 // directory while it computes, so that `mresim resume` (whose checkpoint holds only the

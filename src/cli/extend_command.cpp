@@ -34,6 +34,7 @@ CLI::App* add_extend_command(CLI::App& app, ExtendOptions& options) {
 }
 
 int extend_command(const ExtendOptions& options) {
+  refuse_mpi_job("extend");
   configure_output(options.output, options.dir, true);  // the run's log continues
   mess_protocol::check_extend_overrides(options.overrides);
   const auto computed = finished_run_file(options.dir, {}, "extend");

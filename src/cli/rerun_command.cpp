@@ -34,6 +34,7 @@ CLI::App* add_rerun_command(CLI::App& app, RerunOptions& options) {
 }
 
 int rerun_command(const RerunOptions& options) {
+  refuse_mpi_job("rerun");
   configure_output(options.output, options.dir, true);  // the run's log continues
   mess_protocol::check_rerun_overrides(options.overrides);
   const auto computed = finished_run_file(options.dir, {}, "rerun");

@@ -64,6 +64,7 @@ config::TableReader read_with_overrides_record(const fs::path& dir,
 }
 
 int resume_command(const ResumeOptions& options) {
+  refuse_mpi_job("resume");
   configure_output(options.output, options.dir, true);  // a resumed run continues its log
   const fs::path checkpoint_name = mess_protocol::kCheckpointFile;
   // Locks DIR first: while a run or another resume holds it, nothing is taken over.

@@ -4,7 +4,9 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -47,10 +49,20 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& options) {
   return run;
 }
 
+namespace {
+int configure_run_threads(long threads_option, const app::RunSettings& settings,
+                          const mess::MpiJob& job);
+int participate_in_run(const config::TableReader& root, const app::RunPlan& plan,
+                       long threads_option, const mess::MpiJob& job);
+}  // namespace
+
 int run_command(const RunOptions& options) {
   const fs::path out = options.out.empty() ? fs::path(options.file).stem() : fs::path(options.out);
+  // Under `mpirun -np P` (P > 1, docs/mpi.md) rank 0 does what a single process does; the
+  // others compute alongside it and say nothing (their errors still reach stderr).
+  const mess::MpiJob job = mess::mpi_job();
   // 0. Messages: stderr unless --quiet, and the --log file, from the first line on.
-  configure_output(options.output, out, false);
+  configure_output(job.rank == 0 ? options.output : OutputOptions{true, std::nullopt}, out, false);
 
   // 1. Parse and validate the whole run file, unknown keys included, before touching the disk.
   // --set overrides are applied to the parsed file first, so they are validated as the file is.
@@ -58,14 +70,62 @@ int run_command(const RunOptions& options) {
   refuse_sweep_file(root, options.file);
   std::string run_type;
   const auto plan = app::make_plan(root, &run_type);
+  if (job.size > 1) {
+    if (!plan->splits_over_processes()) {
+      throw std::invalid_argument(fmt::format(
+          "run type '{}' cannot split a run over MPI processes; run it without mpirun (or "
+          "with -np 1)",
+          run_type));
+    }
+    if (job.rank > 0) return participate_in_run(root, *plan, options.threads, job);
+  }
 
   // 2. Claim the output directory (refused if it holds something other than an mresim run).
   io::RunDirectory run_dir(out, io::RunDirectory::Options{options.force});
 
-  return execute_and_publish(root, *plan, run_type, run_dir, options.threads, options.no_plot);
+  const int status =
+      execute_and_publish(root, *plan, run_type, run_dir, options.threads, options.no_plot, job);
+  if (status != kSuccess && job.size > 1) mess::abort_job(status);  // the others may still wait
+  return status;
+}
+
+void refuse_mpi_job(const char* command) {
+  if (mess::mpi_job().size > 1) {
+    throw std::invalid_argument(fmt::format(
+        "mresim {} cannot run over MPI processes yet (docs/mpi.md); run it without mpirun",
+        command));
+  }
 }
 
 namespace {
+
+// Threads per process: the --threads option, else [run].threads; 0 means all cores, which the
+// processes of an MPI job on one machine share (OpenMPI's OMPI_COMM_WORLD_LOCAL_SIZE).
+int configure_run_threads(long threads_option, const app::RunSettings& settings,
+                          const mess::MpiJob& job) {
+  long threads = threads_option >= 0 ? threads_option : settings.threads;
+  if (threads == 0 && job.size > 1) {
+    long local = 1;
+    if (const char* text = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE")) local = std::atol(text);
+    threads = std::max(1L, app::max_threads() / std::max(1L, local));
+  }
+  return app::configure_threads(threads);
+}
+
+// A process other than rank 0 of `mpirun -np P mresim run`: the plan's computation alongside
+// rank 0, nothing written. An error here ends the whole job (rank 0 may be waiting for it).
+int participate_in_run(const config::TableReader& root, const app::RunPlan& plan,
+                       long threads_option, const mess::MpiJob& job) {
+  (void)configure_run_threads(threads_option, app::read_run_settings(root), job);
+  try {
+    plan.participate();
+  } catch (const std::exception& e) {
+    app::run_output().error(fmt::format("mresim: error on MPI process {}: {}", job.rank, e.what()));
+    mess::abort_job(kFailure);
+    throw;
+  }
+  return kSuccess;
+}
 
 // A stop signal ended the run: keep its checkpoint (if any) and say how to go on.
 int report_interrupted(const app::Interrupted& e, io::RunDirectory& run_dir) {
@@ -136,13 +196,12 @@ void write_overrides_record(const config::TableReader& root, const fs::path& dir
 
 int execute_and_publish(const config::TableReader& root, const app::RunPlan& plan,
                         const std::string& run_type, io::RunDirectory& run_dir, long threads_option,
-                        bool no_plot) {
+                        bool no_plot, const mess::MpiJob& job) {
   const app::RunSettings settings = app::read_run_settings(root);
   const fs::path& out = run_dir.shown_path();
 
   // 3. Compute into the staging directory; an exception removes it (RunDirectory destructor).
-  const int threads =
-      app::configure_threads(threads_option >= 0 ? threads_option : settings.threads);
+  const int threads = configure_run_threads(threads_option, settings, job);
   // A run whose results are written but partly invalid (non-finite, unconverged) is still
   // published, with the bad entries marked, and ends with an error (exit status 4).
   std::string invalid_results;
@@ -152,6 +211,7 @@ int execute_and_publish(const config::TableReader& root, const app::RunPlan& pla
     io::write_run_metadata(results, root, run_type);
     results.write_string_attribute("/", "title", settings.title);
     results.write_int_attribute("/", "threads", threads);
+    results.write_int_attribute("/", "mpi_processes", job.size);
     app::Progress progress(0, run_type);
     try {
       plan.execute(run_dir.path(), results, progress);

@@ -34,6 +34,10 @@ void register_run_type(RunType type) {
   types.insert(position, std::move(type));
 }
 
+void RunPlan::participate() const {
+  throw std::logic_error("RunPlan::participate: this run type does not split over processes");
+}
+
 const std::vector<RunType>& run_types() { return registry(); }
 
 const RunType* find_run_type(std::string_view name) {

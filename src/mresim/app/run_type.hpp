@@ -30,6 +30,13 @@ class RunPlan {
   // nothing on disk.
   virtual void execute(const std::filesystem::path& staging_dir, io::Hdf5File& results,
                        Progress& progress) const = 0;
+
+  // `mpirun -np P mresim run` with P > 1 (docs/mpi.md) needs a plan that splits its work over
+  // the processes: rank 0 calls execute(), every other process calls participate() at the
+  // same time (the same computation, writing nothing). Plans that cannot keep these defaults;
+  // the command then refuses to run under mpirun.
+  [[nodiscard]] virtual bool splits_over_processes() const { return false; }
+  virtual void participate() const;  // default: throws std::logic_error
 };
 
 // Reads and validates the run type's own tables from the whole document and returns the plan.

@@ -119,10 +119,7 @@ ElasticEnergies DistributedElastic::evaluate(Vec positions, Vec gradient) const 
 
   const Sums local{node_total[0], cell_total[1], node_total[2], cell_total[3]};
   Sums total{};
-  if (MPI_Allreduce(local.data(), total.data(), static_cast<int>(total.size()), MPI_DOUBLE, MPI_SUM,
-                    d.comm()) != MPI_SUCCESS) {
-    throw std::runtime_error("DistributedElastic: MPI_Allreduce failed");
-  }
+  sum_in_rank_order(d.comm(), local.data(), total.data(), static_cast<int>(total.size()));
   return {total[0], total[1], total[2], total[3]};
 }
 

@@ -4,7 +4,7 @@
 // over a LatticeDecomposition: each process computes the energy of the springs and cells it
 // owns and the gradient at its own nodes, from its nodes' and the ghost layer's positions
 // (PETSc's DMGlobalToLocal brings in the ghosts). The energies are summed over the processes
-// (MPI_Allreduce).
+// in rank order (sum_in_rank_order: the same totals on every process).
 //
 // Same numbers as one process. Every node gathers its springs and cells in the order of the
 // single-process kernels (terms/grid_stencil.hpp: increasing spring and cell index) with the

@@ -14,16 +14,11 @@ namespace mm = mresim::magnetism;
 
 // The terms evaluated here: the elastic ones on each process's nodes, the load as a sum over
 // them, and the terms of the particle centres and magnetizations only, on every process.
-enum class TermRole { elastic, load, centres };
+constexpr std::array<std::string_view, 8> kSupportedTerms = {
+    "springs", "volume", "zeeman", "dipole", "self", "self_linearized", "wca", "load"};
 
-TermRole role_of(std::string_view name) {
-  if (name == "springs" || name == "volume") return TermRole::elastic;
-  if (name == "load") return TermRole::load;
-  constexpr std::array<std::string_view, 5> kCentreTerms = {"zeeman", "dipole", "self",
-                                                            "self_linearized", "wca"};
-  if (std::find(kCentreTerms.begin(), kCentreTerms.end(), name) != kCentreTerms.end()) {
-    return TermRole::centres;
-  }
+void check_supported(std::string_view name) {
+  if (DistributedSystem::supports(name)) return;
   throw std::invalid_argument("DistributedSystem: the energy term '" + std::string(name) +
                               "' cannot be evaluated over processes yet (supported: springs, "
                               "volume, zeeman, dipole, self, self_linearized, wca, load)");
@@ -35,11 +30,15 @@ void check_mpi(int code, const char* what) {
 
 }  // namespace
 
+bool DistributedSystem::supports(std::string_view term) {
+  return std::find(kSupportedTerms.begin(), kSupportedTerms.end(), term) != kSupportedTerms.end();
+}
+
 DistributedSystem::DistributedSystem(MessSystem& system, const LatticeDecomposition& decomposition)
     : system_(system),
       decomposition_(decomposition),
       elastic_(system.lattice(), decomposition, system.settings().elastic.volume_force_factor) {
-  for (const auto& t : system.terms()) (void)role_of(t->name());
+  for (const auto& t : system.terms()) check_supported(t->name());
 
   // The owned particle nodes: their slots in the concatenated particle-node list.
   const lattice::Lattice& lattice = system.lattice();
@@ -165,8 +164,7 @@ Evaluation DistributedSystem::evaluate(Vec positions, Vec gradient) {
         }
       }
       double total = 0.0;
-      check_mpi(MPI_Allreduce(&work, &total, 1, MPI_DOUBLE, MPI_SUM, decomposition_.comm()),
-                "MPI_Allreduce");
+      sum_in_rank_order(decomposition_.comm(), &work, &total, 1);
       values[i] = {-total, 0.0};
     } else {
       values[i] =

@@ -24,6 +24,7 @@
 #include <petscvec.h>
 
 #include <cstdint>
+#include <string_view>
 #include <vector>
 
 #include "mresim/mess/distributed/distributed_elastic.hpp"
@@ -42,6 +43,10 @@ class DistributedSystem {
   // the system's update rule; if `gradient` is not null it is overwritten with the gradient
   // of the potential at the owned nodes (J/m; held coordinates not zeroed).
   Evaluation evaluate(Vec positions, Vec gradient);
+
+  // Whether a term of this name can be evaluated here (the built-in terms; not yet the
+  // optional ones of [terms.<name>] tables).
+  [[nodiscard]] static bool supports(std::string_view term);
 
   // The particle centres at the last evaluate() (3 x N_p, m), the same on every process.
   const Eigen::Matrix3Xd& centres() const { return centres_; }

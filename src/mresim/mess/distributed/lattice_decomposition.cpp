@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "mresim/mess/solvers/amg_preconditioner.hpp"
 
@@ -16,6 +17,23 @@ void check_petsc(PetscErrorCode code, const char* what) {
   (void)PetscErrorMessage(code, &text, nullptr);
   throw std::runtime_error(std::string("PETSc ") + what + ": " +
                            (text != nullptr ? text : "error " + std::to_string(code)));
+}
+
+void sum_in_rank_order(MPI_Comm comm, const double* local, double* total, int count) {
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  std::vector<double> all(static_cast<std::size_t>(size) * static_cast<std::size_t>(count));
+  if (MPI_Allgather(local, count, MPI_DOUBLE, all.data(), count, MPI_DOUBLE, comm) != MPI_SUCCESS) {
+    throw std::runtime_error("sum_in_rank_order: MPI_Allgather failed");
+  }
+  for (int i = 0; i < count; ++i) {
+    double sum = 0.0;
+    for (int r = 0; r < size; ++r) {
+      sum += all[static_cast<std::size_t>(r) * static_cast<std::size_t>(count) +
+                 static_cast<std::size_t>(i)];
+    }
+    total[i] = sum;
+  }
 }
 
 namespace {
@@ -90,7 +108,12 @@ bool LatticeDecomposition::can_split(const lattice::GridShape& shape, int size,
   return false;
 }
 
-LatticeDecomposition::~LatticeDecomposition() { (void)DMDestroy(&dm_); }
+LatticeDecomposition::~LatticeDecomposition() {
+  (void)VecScatterDestroy(&to_all_);
+  (void)VecDestroy(&whole_);
+  (void)VecDestroy(&natural_);
+  (void)DMDestroy(&dm_);
+}
 
 Vec LatticeDecomposition::create_global_vector() const {
   Vec v = nullptr;
@@ -121,28 +144,25 @@ void LatticeDecomposition::scatter(const Eigen::Matrix3Xd& all, Vec global) cons
 
 Eigen::Matrix3Xd LatticeDecomposition::gather(Vec global) const {
   // PETSc's natural order is the lattice's node order (see the header): global -> natural ->
-  // a copy of the whole natural vector on every process.
-  Vec natural = nullptr;
-  check_petsc(DMDACreateNaturalVector(dm_, &natural), "DMDACreateNaturalVector");
-  check_petsc(DMDAGlobalToNaturalBegin(dm_, global, INSERT_VALUES, natural),
+  // a copy of the whole natural vector on every process. The vectors and the scatter are made
+  // on first use and kept.
+  if (natural_ == nullptr) {
+    check_petsc(DMDACreateNaturalVector(dm_, &natural_), "DMDACreateNaturalVector");
+    check_petsc(VecScatterCreateToAll(natural_, &to_all_, &whole_), "VecScatterCreateToAll");
+  }
+  check_petsc(DMDAGlobalToNaturalBegin(dm_, global, INSERT_VALUES, natural_),
               "DMDAGlobalToNaturalBegin");
-  check_petsc(DMDAGlobalToNaturalEnd(dm_, global, INSERT_VALUES, natural),
+  check_petsc(DMDAGlobalToNaturalEnd(dm_, global, INSERT_VALUES, natural_),
               "DMDAGlobalToNaturalEnd");
-  VecScatter to_all = nullptr;
-  Vec whole = nullptr;
-  check_petsc(VecScatterCreateToAll(natural, &to_all, &whole), "VecScatterCreateToAll");
-  check_petsc(VecScatterBegin(to_all, natural, whole, INSERT_VALUES, SCATTER_FORWARD),
+  check_petsc(VecScatterBegin(to_all_, natural_, whole_, INSERT_VALUES, SCATTER_FORWARD),
               "VecScatterBegin");
-  check_petsc(VecScatterEnd(to_all, natural, whole, INSERT_VALUES, SCATTER_FORWARD),
+  check_petsc(VecScatterEnd(to_all_, natural_, whole_, INSERT_VALUES, SCATTER_FORWARD),
               "VecScatterEnd");
   Eigen::Matrix3Xd all(3, shape_.node_count());
   const PetscScalar* values = nullptr;
-  check_petsc(VecGetArrayRead(whole, &values), "VecGetArrayRead");
+  check_petsc(VecGetArrayRead(whole_, &values), "VecGetArrayRead");
   std::copy(values, values + all.size(), all.data());
-  check_petsc(VecRestoreArrayRead(whole, &values), "VecRestoreArrayRead");
-  (void)VecScatterDestroy(&to_all);
-  (void)VecDestroy(&whole);
-  (void)VecDestroy(&natural);
+  check_petsc(VecRestoreArrayRead(whole_, &values), "VecRestoreArrayRead");
   return all;
 }
 

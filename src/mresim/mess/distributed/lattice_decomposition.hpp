@@ -17,6 +17,7 @@
 
 // (PETSc's headers include MPI's without its C++ bindings, which nothing links.)
 #include <petscdm.h>
+#include <petscvec.h>
 
 #include <Eigen/Core>
 #include <array>
@@ -86,9 +87,17 @@ class LatticeDecomposition {
   DM dm_ = nullptr;
   NodeBox owned_;
   NodeBox ghosted_;
+  // gather()'s natural-order vector, its copy on every process and the scatter between them.
+  mutable Vec natural_ = nullptr;
+  mutable Vec whole_ = nullptr;
+  mutable VecScatter to_all_ = nullptr;
 };
 
 // Throws std::runtime_error with PETSc's message unless code is 0.
 void check_petsc(PetscErrorCode code, const char* what);
+
+// Collective: total[i] = the sum over the processes of local[i], added in rank order, so that
+// every process gets bitwise the same totals whatever algorithm MPI_Allreduce would use.
+void sum_in_rank_order(MPI_Comm comm, const double* local, double* total, int count);
 
 }  // namespace mresim::mess

@@ -106,6 +106,7 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
     options.force_tolerance = spec_.solver.minimiser.force_tolerance;
     options.max_iterations = static_cast<int>(spec_.solver.minimiser.max_iterations);
     options.observer = observer_;
+    options.distributed = distributed_;
     const mess::MinimiserResult r = mess::minimise(system_, options);
     record.converged = r.converged;
     record.status = to_string(r.status);

@@ -96,6 +96,11 @@ class ProtocolRunner {
   void set_relaxation_observer(mess::RelaxationObserver observer) {
     observer_ = std::move(observer);
   }
+  // Every relaxation's evaluations split over the evaluator's MPI processes, each of which runs
+  // the same steps on its own runner at the same time (MinimiserOptions::distributed).
+  void set_distributed(std::shared_ptr<mess::DistributedEvaluator> evaluator) {
+    distributed_ = std::move(evaluator);
+  }
 
  private:
   std::size_t slot_of_field(std::size_t field_index) const;
@@ -107,6 +112,7 @@ class ProtocolRunner {
   // solver.method = "newton": the multigrid, built at the first step and kept for the others.
   std::shared_ptr<mess::NewtonCache> newton_cache_ = std::make_shared<mess::NewtonCache>();
   mess::RelaxationObserver observer_;
+  std::shared_ptr<mess::DistributedEvaluator> distributed_;
 };
 
 // Sum of the cell volumes (m^3) at positions x.

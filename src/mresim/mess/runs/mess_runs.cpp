@@ -19,6 +19,10 @@
 #include "mresim/app/run_output.hpp"
 #include "mresim/app/run_type.hpp"
 #include "mresim/app/stop_signal.hpp"
+#include "mresim/config/config_error.hpp"
+#include "mresim/mess/distributed/distributed_evaluator.hpp"
+#include "mresim/mess/distributed/distributed_system.hpp"
+#include "mresim/mess/distributed/mpi_job.hpp"
 #include "mresim/mess/outputs/checkpoint.hpp"
 #include "mresim/mess/outputs/mess_outputs.hpp"
 #include "mresim/mess/protocols/protocol_runner.hpp"
@@ -47,7 +51,12 @@ class MessPlan final : public app::RunPlan {
     // MPI's start forks a helper that would keep results.h5 locked: start it before any file
     // is opened (amg_preconditioner.hpp).
     if (spec_.solver.method == mc::SolverMethod::newton) mess::initialise_petsc();
+    // Under `mpirun -np P` (P > 1) every relaxation's evaluations are split over the
+    // processes (docs/mpi.md): refuse now, on every process, what cannot be split yet.
+    if (mess::mpi_job().size > 1) refuse_what_cannot_split();
   }
+
+  [[nodiscard]] bool splits_over_processes() const override { return true; }
 
   void describe(app::InfoReport& report) const override { mc::describe_mess(spec_, report); }
 
@@ -59,6 +68,12 @@ class MessPlan final : public app::RunPlan {
     progress.note(setup_line());
     ProtocolRunner runner(spec_);
     const fs::path checkpoint = staging_dir / kCheckpointFile;
+    const bool split = split_over_processes(runner);
+    if (split && fs::exists(checkpoint)) {
+      throw std::invalid_argument(
+          "resuming a run over MPI processes is not supported yet; resume it with one process "
+          "(mresim resume without mpirun)");
+    }
     ProtocolState state = fs::exists(checkpoint) ? read_checkpoint(checkpoint, runner, input_toml_)
                                                  : runner.initial_state();
     const std::size_t total = runner.steps().size();
@@ -88,8 +103,10 @@ class MessPlan final : public app::RunPlan {
         write_checkpoint(checkpoint, state, runner, input_toml_, input_name_);
       }
       // SIGINT/SIGTERM: a step boundary is the safe point; checkpoint (whatever checkpoint_every
-      // says) so that `mresim resume` continues from here.
-      if (app::stop_requested() && state.next_step < total) {
+      // says) so that `mresim resume` continues from here. Over MPI processes all stop at the
+      // same step (participate() asks at the same point).
+      const bool stop = split ? mess::any_process(app::stop_requested()) : app::stop_requested();
+      if (stop && state.next_step < total) {
         write_checkpoint(checkpoint, state, runner, input_toml_, input_name_);
         throw app::Interrupted(app::stop_signal(), true,
                                fmt::format("after step {} of {}", state.next_step, total));
@@ -117,7 +134,47 @@ class MessPlan final : public app::RunPlan {
     if (!invalid.empty()) throw app::InvalidResults(invalid);
   }
 
+  // The other processes of `mpirun -np P`: execute()'s computation, collectively with it,
+  // writing nothing (a resumed run is refused by execute(), on rank 0).
+  void participate() const override {
+    ProtocolRunner runner(spec_);
+    (void)split_over_processes(runner);
+    ProtocolState state = runner.initial_state();
+    const std::size_t total = runner.steps().size();
+    while (state.next_step < total) {
+      (void)runner.run_next_step(state);
+      if (mess::any_process(app::stop_requested()) && state.next_step < total) return;
+    }
+  }
+
  private:
+  // Under `mpirun -np P` with P > 1: the runner's relaxations split their evaluations over
+  // all processes. Returns whether it does.
+  static bool split_over_processes(ProtocolRunner& runner) {
+    if (mess::mpi_job().size == 1) return false;
+    runner.set_distributed(std::make_shared<mess::DistributedEvaluator>(MPI_COMM_WORLD));
+    return true;
+  }
+
+  // What splitting over processes does not support yet, as run-file errors naming the key.
+  void refuse_what_cannot_split() const {
+    const char* method = spec_.solver.method == mc::SolverMethod::newton ? "newton" : "leapfrog";
+    if (spec_.solver.method != mc::SolverMethod::lbfgs) {
+      throw config::ConfigError(fmt::format(
+          "solver.method = \"{}\": under mpirun with more than one process only \"lbfgs\" "
+          "splits a relaxation over the processes (docs/mpi.md); run this file without mpirun",
+          method));
+    }
+    for (const mess::TermSpec& term : spec_.terms) {
+      if (!mess::DistributedSystem::supports(term.name)) {
+        throw config::ConfigError(
+            fmt::format("[terms.{}]: this energy term cannot be evaluated over MPI processes yet "
+                        "(docs/mpi.md); run this file without mpirun",
+                        term.name));
+      }
+    }
+  }
+
   // The process's peak resident memory so far (the relaxations are done), in results.h5 and
   // in the log, absolute and per lattice node.
   static void write_peak_memory(io::Hdf5File& results, std::int64_t nodes,

@@ -60,6 +60,9 @@ void MinimiserOptions::validate() const {
   if (!(newton.forcing_max > 0.0 && newton.forcing_max < 1.0)) {
     fail("newton.forcing_max must be in (0, 1)");
   }
+  if (distributed != nullptr && method == MinimiserMethod::newton) {
+    fail("method newton cannot split its work over MPI processes yet (docs/mpi.md); use lbfgs");
+  }
   if (!(newton.amg.threshold >= 0.0) || newton.amg.smoothings < 0) {
     fail("newton.amg parameters out of range");
   }
@@ -346,7 +349,7 @@ class Minimisation {
         force_scale_(force_scale),
         map_(map),
         measure_(system, map),
-        f_(system, map, force_scale),
+        f_(system, map, force_scale, options.distributed.get()),
         u_(map.to_dofs(system.positions())),
         // Nodal masses in units of m_c (FIRE only).
         mass_(map.reduce_masses(system.lattice().masses) /

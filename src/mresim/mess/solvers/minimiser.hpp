@@ -93,7 +93,8 @@ struct NewtonOptions {
   AmgOptions amg;
 };
 
-struct NewtonCache;  // newton.hpp
+struct NewtonCache;          // newton.hpp
+class DistributedEvaluator;  // distributed/distributed_evaluator.hpp
 
 struct MinimiserOptions {
   MinimiserMethod method = MinimiserMethod::lbfgs;
@@ -116,6 +117,10 @@ struct MinimiserOptions {
   std::shared_ptr<NewtonCache> newton_cache;
   // Told every convergence check's largest force (progress reports); changes nothing.
   RelaxationObserver observer;
+  // lbfgs and fire: every evaluation split over the evaluator's MPI processes, each of which
+  // calls minimise() on its own copy of the same system at the same time (docs/mpi.md);
+  // null: this process alone.
+  std::shared_ptr<DistributedEvaluator> distributed;
 
   void validate() const;  // throws std::invalid_argument naming the option
 };

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "mresim/mess/distributed/distributed_evaluator.hpp"
+
 namespace mresim::mess::detail {
 
 double characteristic_mass(const lattice::Lattice& lat) {
@@ -41,12 +43,17 @@ double ForceMeasure::max_force(const Eigen::Matrix3Xd& gradient) const {
   return m;
 }
 
-Objective::Objective(MessSystem& system, const DofMap& map, double force_scale)
-    : system_(system), map_(map), e0_(force_scale * map.length_scale()) {}
+Objective::Objective(MessSystem& system, const DofMap& map, double force_scale,
+                     DistributedEvaluator* distributed)
+    : system_(system),
+      map_(map),
+      e0_(force_scale * map.length_scale()),
+      distributed_(distributed) {}
 
 double Objective::operator()(const Eigen::VectorXd& u, Eigen::VectorXd& gradient) {
   map_.to_positions(u, system_.mutable_positions());
-  last_ = system_.evaluate(&gradient_);
+  last_ = distributed_ != nullptr ? distributed_->evaluate(system_, &gradient_)
+                                  : system_.evaluate(&gradient_);
   ++evaluations_;
   gradient = map_.reduce(gradient_) / e0_;
   return last_.potential / e0_;

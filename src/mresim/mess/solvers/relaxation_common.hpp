@@ -10,6 +10,10 @@
 #include "mresim/mess/system/constraints.hpp"
 #include "mresim/mess/system/system_energy.hpp"
 
+namespace mresim::mess {
+class DistributedEvaluator;  // distributed/distributed_evaluator.hpp
+}  // namespace mresim::mess
+
 namespace mresim::mess::detail {
 
 // m_c = rho_polymer l_e^3, the mass of an interior polymer node (Section 4.2.6), recovered from
@@ -34,7 +38,11 @@ class ForceMeasure {
 // Every call moves the system to u and evaluates it (re-solving M per the system's rule).
 class Objective {
  public:
-  Objective(MessSystem& system, const DofMap& map, double force_scale);
+  // With `distributed` not null every evaluation is split over its processes (each process
+  // holding the same system and calling at the same time): the same gradient, energies to
+  // rounding (distributed/distributed_evaluator.hpp).
+  Objective(MessSystem& system, const DofMap& map, double force_scale,
+            DistributedEvaluator* distributed = nullptr);
 
   double operator()(const Eigen::VectorXd& u, Eigen::VectorXd& gradient);
 
@@ -50,6 +58,7 @@ class Objective {
   MessSystem& system_;
   const DofMap& map_;
   double e0_;
+  DistributedEvaluator* distributed_;
   Evaluation last_;
   Eigen::Matrix3Xd gradient_;
   std::int64_t evaluations_ = 0;

@@ -1,0 +1,41 @@
+#include "mresim/mess/distributed/mpi_job.hpp"
+
+#include <petscsys.h>  // MPI, without its C++ bindings
+
+#include <algorithm>
+#include <array>
+#include <cstdlib>
+
+#include "mresim/mess/solvers/amg_preconditioner.hpp"
+
+namespace mresim::mess {
+
+bool started_by_mpi_launcher() {
+  constexpr std::array<const char*, 3> kLaunchVariables = {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK",
+                                                           "PMI_SIZE"};
+  return std::any_of(kLaunchVariables.begin(), kLaunchVariables.end(),
+                     [](const char* name) { return std::getenv(name) != nullptr; });
+}
+
+MpiJob mpi_job() {
+  if (!started_by_mpi_launcher()) return {};
+  initialise_petsc();
+  MpiJob job;
+  MPI_Comm_rank(MPI_COMM_WORLD, &job.rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &job.size);
+  return job;
+}
+
+bool any_process(bool flag) {
+  if (mpi_job().size == 1) return flag;
+  int mine = flag ? 1 : 0;
+  int any = 0;
+  MPI_Allreduce(&mine, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  return any != 0;
+}
+
+void abort_job(int status) {
+  if (mpi_job().size > 1) MPI_Abort(MPI_COMM_WORLD, status);
+}
+
+}  // namespace mresim::mess
