@@ -3,6 +3,7 @@
 //
 //   mpirun -np 2 ./build/mess_mpi_bench                 (Fig. 4.11 pair, 1 thread per process)
 //   mpirun -np 2 ./build/mess_mpi_bench --system fig4_25_helix --repeats 10 --threads 1
+//   mpirun -np 2 ./build/mess_mpi_bench --relax-steps 2  (also the run's first two steps)
 //
 // (OpenMPI binds each process to a core when there are at most two: with --threads above 1
 // add --bind-to none, or the threads share one core.)
@@ -14,7 +15,11 @@
 //  - DistributedElastic::evaluate (energy + gradient) on process 0 alone (a communicator of
 //    one), then on all P processes (the time of the slowest, between barriers);
 // and printed: the times, nodes per second, the 1 -> P speed-up, and whether the distributed
-// gradient is bitwise the single-process one (it must be).
+// gradient is bitwise the single-process one (it must be). With --relax-steps N, also the run's
+// first N steps relaxed as `mresim run` relaxes them (L-BFGS, the run file's settings): on
+// process 0 alone without MPI, on process 0 over a communicator of one, and on all P processes
+// (mpirun -np P mresim run), with the speed-up and the largest difference of the final
+// particle centres from the single-process run.
 #include <omp.h>
 #include <petscvec.h>
 
@@ -28,6 +33,7 @@
 
 #include "mresim/config/table_reader.hpp"
 #include "mresim/mess/distributed/distributed_elastic.hpp"
+#include "mresim/mess/distributed/distributed_evaluator.hpp"
 #include "mresim/mess/protocols/protocol_runner.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
 #include "mresim/mess/solvers/amg_preconditioner.hpp"
@@ -40,7 +46,8 @@ namespace mess = mresim::mess;
 struct Options {
   std::string system = "fig4_11";
   int repeats = 5;
-  int threads = 1;  // OpenMP threads per process
+  int threads = 1;      // OpenMP threads per process
+  int relax_steps = 0;  // > 0: also time the run's first steps as `mresim run` relaxes them
 };
 
 const char* run_file_of(const std::string& system) {
@@ -60,15 +67,17 @@ Options parse(int argc, char** argv) {
       o.repeats = std::stoi(value);
     } else if (key == "--threads") {
       o.threads = std::stoi(value);
+    } else if (key == "--relax-steps") {
+      o.relax_steps = std::stoi(value);
     } else {
       std::fprintf(stderr, "mess_mpi_bench: unknown option %s\n", key.c_str());
       std::exit(2);
     }
   }
-  if (run_file_of(o.system) == nullptr || o.repeats < 1 || o.threads < 1) {
+  if (run_file_of(o.system) == nullptr || o.repeats < 1 || o.threads < 1 || o.relax_steps < 0) {
     std::fprintf(stderr,
                  "mess_mpi_bench: --system must be fig4_11 or fig4_25_helix, --repeats and "
-                 "--threads >= 1\n");
+                 "--threads >= 1, --relax-steps >= 0\n");
     std::exit(2);
   }
   return o;
@@ -126,6 +135,58 @@ DistributedRun run_on(MPI_Comm comm, const mess::MessSystem& system, const Eigen
   (void)VecDestroy(&positions);
   (void)VecDestroy(&gradient);
   return run;
+}
+
+struct Relaxation {
+  double seconds = 0.0;
+  std::int64_t evaluations = 0;
+  Eigen::Matrix3Xd centres;
+};
+
+// The run's first `steps` steps as `mresim run` relaxes them, evaluations split over `comm`
+// (MPI_COMM_NULL: this process alone, no MPI); every process of `comm` calls this.
+Relaxation relax(const mresim::mess_config::MessSpec& spec, int steps, MPI_Comm comm) {
+  mresim::mess_protocol::ProtocolRunner runner(spec);
+  if (comm != MPI_COMM_NULL)
+    runner.set_distributed(std::make_shared<mess::DistributedEvaluator>(comm));
+  mresim::mess_protocol::ProtocolState state = runner.initial_state();
+  Relaxation r;
+  const auto start = std::chrono::steady_clock::now();
+  for (int k = 0; k < steps && state.next_step < runner.steps().size(); ++k) {
+    r.evaluations += runner.run_next_step(state).evaluations;
+  }
+  r.seconds = seconds_since(start);
+  r.centres = runner.system().particle_centres();
+  return r;
+}
+
+// Relaxation times: this process alone without MPI, alone over a communicator of one, then all
+// processes; printed by process 0 with the speed-up and how far apart the final centres are.
+void time_relaxations(const mresim::mess_config::MessSpec& spec, int steps, int rank, int size) {
+  Relaxation serial;
+  Relaxation one;
+  MPI_Comm alone = MPI_COMM_NULL;
+  MPI_Comm_split(MPI_COMM_WORLD, rank == 0 ? 0 : MPI_UNDEFINED, 0, &alone);
+  if (rank == 0) {
+    serial = relax(spec, steps, MPI_COMM_NULL);
+    one = relax(spec, steps, alone);
+    MPI_Comm_free(&alone);
+  }
+  wait_quietly(MPI_COMM_WORLD);
+  const Relaxation all = relax(spec, steps, MPI_COMM_WORLD);
+  if (rank != 0) return;
+  const auto apart = [&](const Relaxation& r) {
+    return r.centres.cols() > 0 ? (r.centres - serial.centres).cwiseAbs().maxCoeff() : 0.0;
+  };
+  std::printf("  relaxation of the run's first %d steps (what mresim run does):\n", steps);
+  std::printf("    one process, no MPI:      %8.2f s  %lld evaluations\n", serial.seconds,
+              static_cast<long long>(serial.evaluations));
+  std::printf("    distributed, 1 process:   %8.2f s  %lld evaluations  centres %.2e m apart\n",
+              one.seconds, static_cast<long long>(one.evaluations), apart(one));
+  std::printf("    distributed, %d processes: %8.2f s  %lld evaluations  centres %.2e m apart\n",
+              size, all.seconds, static_cast<long long>(all.evaluations), apart(all));
+  std::printf("    speed-up 1 -> %d processes: %.2fx (against no MPI: %.2fx)\n", size,
+              one.seconds / all.seconds, serial.seconds / all.seconds);
 }
 
 }  // namespace
@@ -191,5 +252,6 @@ int main(int argc, char** argv) {
         all.bitwise ? "bitwise the single-process one" : "DIFFERS");
     std::printf("  speed-up 1 -> %d processes: %.2fx\n", size, one.seconds / all.seconds);
   }
+  if (options.relax_steps > 0) time_relaxations(spec, options.relax_steps, rank, size);
   return one.bitwise || rank != 0 ? (all.bitwise ? 0 : 1) : 1;
 }

@@ -80,13 +80,20 @@ int run_command(const RunOptions& options) {
     if (job.rank > 0) return participate_in_run(root, *plan, options.threads, job);
   }
 
-  // 2. Claim the output directory (refused if it holds something other than an mresim run).
-  io::RunDirectory run_dir(out, io::RunDirectory::Options{options.force});
-
-  const int status =
-      execute_and_publish(root, *plan, run_type, run_dir, options.threads, options.no_plot, job);
-  if (status != kSuccess && job.size > 1) mess::abort_job(status);  // the others may still wait
-  return status;
+  try {
+    // 2. Claim the output directory (refused if it holds something other than an mresim run).
+    io::RunDirectory run_dir(out, io::RunDirectory::Options{options.force});
+    return execute_and_publish(root, *plan, run_type, run_dir, options.threads, options.no_plot,
+                               job);
+  } catch (const std::exception& e) {
+    // Under mpirun the other processes may be waiting for this one in a collective call:
+    // end them all (an exit status from here, with the message, never a hang).
+    if (job.size > 1) {
+      app::run_output().error(fmt::format("mresim: error: {}", e.what()));
+      mess::abort_job(kFailure);
+    }
+    throw;
+  }
 }
 
 void refuse_mpi_job(const char* command) {
