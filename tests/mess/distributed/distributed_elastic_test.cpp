@@ -22,35 +22,20 @@
 #include <vector>
 
 #include "../support/mess_test_support.hpp"
+#include "mpi_test_support.hpp"
 #include "mresim/mess/profile/model_profile.hpp"
 #include "mresim/mess/solvers/amg_preconditioner.hpp"
 #include "mresim/mess/terms/elastic_terms.hpp"
 
 namespace mess = mresim::mess;
 namespace lat = mresim::lattice;
+using mess::testing::everywhere;
 using mess::testing::perturbed;
+using mess::testing::relative_difference;
 using mess::testing::small_lattice;
+using mess::testing::world_size;
 
 namespace {
-
-int world_size() {
-  mess::initialise_petsc();
-  int size = 1;
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
-  return size;
-}
-
-// True on every process when `ok` holds on every process.
-bool everywhere(bool ok) {
-  int mine = ok ? 1 : 0;
-  int all = 0;
-  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-  return all == 1;
-}
-
-double relative_difference(double a, double b) {
-  return std::abs(a - b) / std::max(std::abs(b), 1e-300);
-}
 
 // The splits to try: all processes along x, then y, then z, then PETSc's choice.
 std::vector<std::array<int, 3>> splits() {

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "../support/mess_test_support.hpp"
+#include "mpi_test_support.hpp"
 #include "mresim/mess/distributed/distributed_evaluator.hpp"
 #include "mresim/mess/distributed/lattice_decomposition.hpp"
 #include "mresim/mess/distributed/mpi_job.hpp"
@@ -22,24 +23,12 @@
 
 namespace mess = mresim::mess;
 namespace lat = mresim::lattice;
+using mess::testing::everywhere;
 using mess::testing::small_lattice;
 using mess::testing::tesla;
+using mess::testing::world_rank;
 
 namespace {
-
-bool everywhere(bool ok) {
-  int mine = ok ? 1 : 0;
-  int all = 0;
-  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-  return all == 1;
-}
-
-int world_rank() {
-  mess::initialise_petsc();
-  int rank = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  return rank;
-}
 
 // Two n_d = 1 particles of the seed profile at 50 mT along z, every face held.
 mess::MessSystem held_pair() {

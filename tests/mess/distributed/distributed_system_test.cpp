@@ -14,27 +14,19 @@
 #include <string>
 
 #include "../support/mess_test_support.hpp"
+#include "mpi_test_support.hpp"
 #include "mresim/config/table_reader.hpp"
 #include "mresim/mess/profile/model_profile.hpp"
 #include "mresim/mess/solvers/amg_preconditioner.hpp"
 
 namespace mess = mresim::mess;
+using mess::testing::everywhere;
 using mess::testing::perturbed;
+using mess::testing::relative_difference;
 using mess::testing::small_lattice;
 using mess::testing::tesla;
 
 namespace {
-
-bool everywhere(bool ok) {
-  int mine = ok ? 1 : 0;
-  int all = 0;
-  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-  return all == 1;
-}
-
-double relative_difference(double a, double b) {
-  return std::abs(a - b) / std::max(std::abs(b), 1e-300);
-}
 
 // Two n_d = 1 particles, 100 mT oblique, a pull on the top face's nodes.
 mess::MessSystem loaded_pair(const mess::ModelProfile& profile) {

@@ -11,14 +11,6 @@
 
 namespace mresim::mess {
 
-void check_petsc(PetscErrorCode code, const char* what) {
-  if (code == 0) return;
-  const char* text = nullptr;
-  (void)PetscErrorMessage(code, &text, nullptr);
-  throw std::runtime_error(std::string("PETSc ") + what + ": " +
-                           (text != nullptr ? text : "error " + std::to_string(code)));
-}
-
 void sum_in_rank_order(MPI_Comm comm, const double* local, double* total, int count) {
   int size = 1;
   MPI_Comm_size(comm, &size);

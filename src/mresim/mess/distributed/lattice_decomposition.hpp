@@ -24,6 +24,7 @@
 #include <cstdint>
 
 #include "mresim/mess/lattice/grid.hpp"
+#include "mresim/mess/solvers/amg_preconditioner.hpp"  // initialise_petsc, check_petsc
 
 namespace mresim::mess {
 
@@ -92,9 +93,6 @@ class LatticeDecomposition {
   mutable Vec whole_ = nullptr;
   mutable VecScatter to_all_ = nullptr;
 };
-
-// Throws std::runtime_error with PETSc's message unless code is 0.
-void check_petsc(PetscErrorCode code, const char* what);
 
 // Collective: total[i] = the sum over the processes of local[i], added in rank order, so that
 // every process gets bitwise the same totals whatever algorithm MPI_Allreduce would use.

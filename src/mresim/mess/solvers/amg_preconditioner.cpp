@@ -8,29 +8,25 @@
 
 namespace mresim::mess {
 
-namespace {
-
-void check(PetscErrorCode code, const char* what) {
+void check_petsc(int code, const char* what) {
   if (code == 0) return;
   const char* text = nullptr;
-  (void)PetscErrorMessage(code, &text, nullptr);
+  (void)PetscErrorMessage(static_cast<PetscErrorCode>(code), &text, nullptr);
   throw std::runtime_error(std::string("PETSc ") + what + ": " +
                            (text != nullptr ? text : "error " + std::to_string(code)));
 }
 
-}  // namespace
-
 // PETSc (and MPI, as a singleton when the program was not started by mpirun) is finalised at
-// exit. PETSc's errors are returned, not printed, so that check() can report them.
+// exit. PETSc's errors are returned, not printed, so that check_petsc() can report them.
 void initialise_petsc() {
   static const bool initialised = [] {
     PetscBool already = PETSC_FALSE;
-    check(PetscInitialized(&already), "PetscInitialized");
+    check_petsc(PetscInitialized(&already), "PetscInitialized");
     if (already == PETSC_FALSE) {
-      check(PetscInitializeNoArguments(), "PetscInitialize");
+      check_petsc(PetscInitializeNoArguments(), "PetscInitialize");
       (void)std::atexit([] { (void)PetscFinalize(); });
     }
-    check(PetscPushErrorHandler(PetscReturnErrorHandler, nullptr), "PetscPushErrorHandler");
+    check_petsc(PetscPushErrorHandler(PetscReturnErrorHandler, nullptr), "PetscPushErrorHandler");
     return true;
   }();
   (void)initialised;
@@ -68,34 +64,35 @@ AmgPreconditioner::AmgPreconditioner(const ElasticMatrix& matrix,
   }
   // PETSc reads the arrays in place (no copy); it never writes them.
   // NOLINTBEGIN(cppcoreguidelines-pro-type-const-cast)
-  check(MatCreateSeqAIJWithArrays(PETSC_COMM_SELF, p.size, p.size,
-                                  const_cast<PetscInt*>(matrix.row_start().data()),
-                                  const_cast<PetscInt*>(matrix.columns().data()),
-                                  const_cast<PetscScalar*>(matrix.values().data()), &p.matrix),
-        "MatCreateSeqAIJWithArrays");
+  check_petsc(MatCreateSeqAIJWithArrays(
+                  PETSC_COMM_SELF, p.size, p.size, const_cast<PetscInt*>(matrix.row_start().data()),
+                  const_cast<PetscInt*>(matrix.columns().data()),
+                  const_cast<PetscScalar*>(matrix.values().data()), &p.matrix),
+              "MatCreateSeqAIJWithArrays");
   // NOLINTEND(cppcoreguidelines-pro-type-const-cast)
-  check(MatSetBlockSize(p.matrix, 3), "MatSetBlockSize");
-  check(VecCreateSeqWithArray(PETSC_COMM_SELF, 3, p.size, nullptr, &p.in), "VecCreate");
-  check(VecCreateSeqWithArray(PETSC_COMM_SELF, 3, p.size, nullptr, &p.out), "VecCreate");
+  check_petsc(MatSetBlockSize(p.matrix, 3), "MatSetBlockSize");
+  check_petsc(VecCreateSeqWithArray(PETSC_COMM_SELF, 3, p.size, nullptr, &p.in), "VecCreate");
+  check_petsc(VecCreateSeqWithArray(PETSC_COMM_SELF, 3, p.size, nullptr, &p.out), "VecCreate");
 
   // The six rigid-body modes of the node positions as GAMG's near-null space.
   Vec xyz = nullptr;
-  check(VecCreateSeqWithArray(PETSC_COMM_SELF, 3, p.size, coordinates.data(), &xyz), "VecCreate");
+  check_petsc(VecCreateSeqWithArray(PETSC_COMM_SELF, 3, p.size, coordinates.data(), &xyz),
+              "VecCreate");
   MatNullSpace modes = nullptr;
-  check(MatNullSpaceCreateRigidBody(xyz, &modes), "MatNullSpaceCreateRigidBody");
-  check(MatSetNearNullSpace(p.matrix, modes), "MatSetNearNullSpace");
+  check_petsc(MatNullSpaceCreateRigidBody(xyz, &modes), "MatNullSpaceCreateRigidBody");
+  check_petsc(MatSetNearNullSpace(p.matrix, modes), "MatSetNearNullSpace");
   (void)MatNullSpaceDestroy(&modes);
   (void)VecDestroy(&xyz);
 
-  check(PCCreate(PETSC_COMM_SELF, &p.pc), "PCCreate");
-  check(PCSetOperators(p.pc, p.matrix, p.matrix), "PCSetOperators");
-  check(PCSetType(p.pc, PCGAMG), "PCSetType");
-  check(PCGAMGSetType(p.pc, PCGAMGAGG), "PCGAMGSetType");
-  check(PCGAMGSetNSmooths(p.pc, options.smoothings), "PCGAMGSetNSmooths");
+  check_petsc(PCCreate(PETSC_COMM_SELF, &p.pc), "PCCreate");
+  check_petsc(PCSetOperators(p.pc, p.matrix, p.matrix), "PCSetOperators");
+  check_petsc(PCSetType(p.pc, PCGAMG), "PCSetType");
+  check_petsc(PCGAMGSetType(p.pc, PCGAMGAGG), "PCGAMGSetType");
+  check_petsc(PCGAMGSetNSmooths(p.pc, options.smoothings), "PCGAMGSetNSmooths");
   PetscReal threshold = options.threshold;
-  check(PCGAMGSetThreshold(p.pc, &threshold, 1), "PCGAMGSetThreshold");
-  check(PCSetFromOptions(p.pc), "PCSetFromOptions");  // PETSC_OPTIONS may refine it
-  check(PCSetUp(p.pc), "PCSetUp (GAMG)");
+  check_petsc(PCGAMGSetThreshold(p.pc, &threshold, 1), "PCGAMGSetThreshold");
+  check_petsc(PCSetFromOptions(p.pc), "PCSetFromOptions");  // PETSC_OPTIONS may refine it
+  check_petsc(PCSetUp(p.pc), "PCSetUp (GAMG)");
 }
 
 AmgPreconditioner::AmgPreconditioner(AmgPreconditioner&&) noexcept = default;
@@ -106,17 +103,17 @@ void AmgPreconditioner::apply(const Eigen::VectorXd& in, Eigen::VectorXd& out) c
   Impl& p = *impl_;
   if (in.size() != p.size) throw std::invalid_argument("AmgPreconditioner::apply: wrong size");
   out.resize(p.size);
-  check(VecPlaceArray(p.in, in.data()), "VecPlaceArray");
-  check(VecPlaceArray(p.out, out.data()), "VecPlaceArray");
+  check_petsc(VecPlaceArray(p.in, in.data()), "VecPlaceArray");
+  check_petsc(VecPlaceArray(p.out, out.data()), "VecPlaceArray");
   const PetscErrorCode code = PCApply(p.pc, p.in, p.out);
   (void)VecResetArray(p.in);
   (void)VecResetArray(p.out);
-  check(code, "PCApply");
+  check_petsc(code, "PCApply");
 }
 
 int AmgPreconditioner::levels() const {
   PetscInt levels = 0;
-  check(PCMGGetLevels(impl_->pc, &levels), "PCMGGetLevels");
+  check_petsc(PCMGGetLevels(impl_->pc, &levels), "PCMGGetLevels");
   return static_cast<int>(levels);
 }
 

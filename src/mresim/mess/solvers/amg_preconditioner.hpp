@@ -30,6 +30,10 @@ namespace mresim::mess {
 // results.h5).
 void initialise_petsc();
 
+// Throws std::runtime_error("PETSc <what>: <PETSc's message>") unless code is 0 (the PETSc
+// error handler set by initialise_petsc() returns errors instead of printing them).
+void check_petsc(int code, const char* what);
+
 struct AmgOptions {
   double threshold = 0.02;  // GAMG's strength-of-connection threshold
   int smoothings = 1;       // prolongator smoothing steps (smoothed aggregation)
