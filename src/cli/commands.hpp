@@ -48,7 +48,16 @@ int execute_and_publish(const config::TableReader& root, const app::RunPlan& pla
                         const std::string& run_type, io::RunDirectory& run_dir, long threads_option,
                         bool no_plot, const mess::MpiJob& job = {});
 
-// Commands that cannot run over MPI processes yet (resume, extend, rerun) call this first:
+// A process other than rank 0 of `mpirun -np P mresim run/resume`: the plan's computation
+// alongside rank 0 (RunPlan::participate), nothing written; `staging_dir`: rank 0's, when it
+// resumes. An error here ends the whole job (rank 0 may be waiting for it).
+int participate_in_run(const config::TableReader& root, const app::RunPlan& plan,
+                       long threads_option, const mess::MpiJob& job,
+                       const std::filesystem::path& staging_dir);
+// Under mpirun with P > 1: throws std::invalid_argument unless the plan splits over processes.
+void refuse_unsplittable_plan(const app::RunPlan& plan, const std::string& run_type);
+
+// Commands that cannot run over MPI processes yet (extend, rerun) call this first:
 // under mpirun with more than one process it throws std::invalid_argument naming `command`.
 void refuse_mpi_job(const char* command);
 

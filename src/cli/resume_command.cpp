@@ -3,6 +3,7 @@
 // run file stored in the checkpoint and lets the run type continue from there. Only run types
 // that write checkpoints (the 3D runs, [output] checkpoint_every) can be resumed.
 
+#include <fmt/format.h>
 #include <toml++/toml.h>
 
 #include <cstdio>
@@ -14,6 +15,7 @@
 #include "cli/commands.hpp"
 #include "cli/exit_status.hpp"
 #include "mresim/app/run_output.hpp"
+#include "mresim/app/run_type.hpp"
 #include "mresim/io/hdf5_reader.hpp"
 #include "mresim/io/run_directory.hpp"
 #include "mresim/mess/outputs/checkpoint.hpp"
@@ -63,29 +65,67 @@ config::TableReader read_with_overrides_record(const fs::path& dir,
   return config::TableReader::parse_string(effective_text, name);
 }
 
-int resume_command(const ResumeOptions& options) {
-  refuse_mpi_job("resume");
-  configure_output(options.output, options.dir, true);  // a resumed run continues its log
-  const fs::path checkpoint_name = mess_protocol::kCheckpointFile;
-  // Locks DIR first: while a run or another resume holds it, nothing is taken over.
-  const auto run_dir = io::RunDirectory::resume(options.dir, checkpoint_name);
+namespace {
+
+// The run file to continue: the checkpoint's effective run file, with the overrides record
+// beside it (see read_with_overrides_record).
+config::TableReader checkpointed_run_file(const fs::path& staging_dir) {
   std::string text;
   std::string name;
   {
-    const io::Hdf5Reader checkpoint(run_dir->path() / checkpoint_name);
+    const io::Hdf5Reader checkpoint(staging_dir / mess_protocol::kCheckpointFile);
     text = checkpoint.string_attribute("/", "input_toml");
     name = checkpoint.string_attribute("/", "input_file");
   }
-  // A run with --set: the checkpoint holds the effective run file; the record beside it the file
-  // as written and the overrides, so that the resumed results.h5 records them as a run would.
-  const auto root = read_with_overrides_record(run_dir->path(), text, name);
-  std::string run_type;
-  const auto plan = app::make_plan(root, &run_type);
-  if (!app::run_output().quiet()) {
-    std::printf("mresim: resuming the run in %s\n", run_dir->path().string().c_str());
-    std::fflush(stdout);
+  return read_with_overrides_record(staging_dir, text, name);
+}
+
+}  // namespace
+
+int resume_command(const ResumeOptions& options) {
+  // Under `mpirun -np P` (P > 1) rank 0 resumes as a single process would and tells the others
+  // its staging directory; they read the same checkpoint and compute alongside it (docs/mpi.md).
+  const mess::MpiJob job = mess::mpi_job();
+  // A resumed run continues its log.
+  configure_output(job.rank == 0 ? options.output : OutputOptions{true, std::nullopt}, options.dir,
+                   true);
+  if (job.rank > 0) {
+    const fs::path staging_dir = mess::broadcast_text({});
+    const auto root = checkpointed_run_file(staging_dir);
+    std::string run_type;
+    const auto plan = app::make_plan(root, &run_type);
+    refuse_unsplittable_plan(*plan, run_type);
+    return participate_in_run(root, *plan, options.threads, job, staging_dir);
   }
-  return execute_and_publish(root, *plan, run_type, *run_dir, options.threads, options.no_plot);
+  try {
+    const fs::path checkpoint_name = mess_protocol::kCheckpointFile;
+    // Locks DIR first: while a run or another resume holds it, nothing is taken over.
+    const auto run_dir = io::RunDirectory::resume(options.dir, checkpoint_name);
+    // A run with --set: the checkpoint holds the effective run file; the record beside it the
+    // file as written and the overrides, so that the resumed results.h5 records them as a run
+    // would.
+    const auto root = checkpointed_run_file(run_dir->path());
+    std::string run_type;
+    const auto plan = app::make_plan(root, &run_type);
+    if (job.size > 1) {
+      refuse_unsplittable_plan(*plan, run_type);
+      (void)mess::broadcast_text(run_dir->path().string());
+    }
+    if (!app::run_output().quiet()) {
+      std::printf("mresim: resuming the run in %s\n", run_dir->path().string().c_str());
+      std::fflush(stdout);
+    }
+    return execute_and_publish(root, *plan, run_type, *run_dir, options.threads, options.no_plot,
+                               job);
+  } catch (const std::exception& e) {
+    // The other processes may be waiting for this one (for the staging directory or in a
+    // collective call): end them all.
+    if (job.size > 1) {
+      app::run_output().error(fmt::format("mresim: error: {}", e.what()));
+      mess::abort_job(kFailure);
+    }
+    throw;
+  }
 }
 
 }  // namespace mresim::cli

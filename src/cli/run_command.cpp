@@ -52,8 +52,6 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& options) {
 namespace {
 int configure_run_threads(long threads_option, const app::RunSettings& settings,
                           const mess::MpiJob& job);
-int participate_in_run(const config::TableReader& root, const app::RunPlan& plan,
-                       long threads_option, const mess::MpiJob& job);
 }  // namespace
 
 int run_command(const RunOptions& options) {
@@ -71,13 +69,8 @@ int run_command(const RunOptions& options) {
   std::string run_type;
   const auto plan = app::make_plan(root, &run_type);
   if (job.size > 1) {
-    if (!plan->splits_over_processes()) {
-      throw std::invalid_argument(fmt::format(
-          "run type '{}' cannot split a run over MPI processes; run it without mpirun (or "
-          "with -np 1)",
-          run_type));
-    }
-    if (job.rank > 0) return participate_in_run(root, *plan, options.threads, job);
+    refuse_unsplittable_plan(*plan, run_type);
+    if (job.rank > 0) return participate_in_run(root, *plan, options.threads, job, {});
   }
 
   try {
@@ -119,13 +112,13 @@ int configure_run_threads(long threads_option, const app::RunSettings& settings,
   return app::configure_threads(threads);
 }
 
-// A process other than rank 0 of `mpirun -np P mresim run`: the plan's computation alongside
-// rank 0, nothing written. An error here ends the whole job (rank 0 may be waiting for it).
+}  // namespace
+
 int participate_in_run(const config::TableReader& root, const app::RunPlan& plan,
-                       long threads_option, const mess::MpiJob& job) {
+                       long threads_option, const mess::MpiJob& job, const fs::path& staging_dir) {
   (void)configure_run_threads(threads_option, app::read_run_settings(root), job);
   try {
-    plan.participate();
+    plan.participate(staging_dir);
   } catch (const std::exception& e) {
     app::run_output().error(fmt::format("mresim: error on MPI process {}: {}", job.rank, e.what()));
     mess::abort_job(kFailure);
@@ -133,6 +126,17 @@ int participate_in_run(const config::TableReader& root, const app::RunPlan& plan
   }
   return kSuccess;
 }
+
+void refuse_unsplittable_plan(const app::RunPlan& plan, const std::string& run_type) {
+  if (!plan.splits_over_processes()) {
+    throw std::invalid_argument(fmt::format(
+        "run type '{}' cannot split a run over MPI processes; run it without mpirun (or with "
+        "-np 1)",
+        run_type));
+  }
+}
+
+namespace {
 
 // A stop signal ended the run: keep its checkpoint (if any) and say how to go on.
 int report_interrupted(const app::Interrupted& e, io::RunDirectory& run_dir) {

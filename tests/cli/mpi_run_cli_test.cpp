@@ -1,16 +1,19 @@
 // `mpirun -np 2 mresim run FILE` (docs/mpi.md): a 3D run whose relaxations split their
 // evaluations over two processes gives the results of a single process within the issue's
 // agreement (1 nm in particle centres, 1e-6 in M/Ms, 1e-6 relative in energy density, the same
-// convergence), rank 0 writes the run directory alone, and what cannot be split yet is refused
-// before anything is written.
+// convergence), rank 0 writes the run directory alone, what cannot be split yet is refused
+// before anything is written, and a run stopped by SIGTERM resumes over two processes.
 
 #include <gtest/gtest.h>
+#include <signal.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "../support/child_process.hpp"
@@ -124,10 +127,10 @@ TEST(MpiRunCli, RefusesWhatCannotSplitOverProcesses) {
   EXPECT_NE(r.err.find("solver.method = \"newton\""), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "newton"));
 
-  const Result resume = run(dir.path(), 2, {"resume", "newton"});
-  EXPECT_NE(resume.status, 0);
-  EXPECT_NE(resume.err.find("mresim resume cannot run over MPI processes"), std::string::npos)
-      << resume.err;
+  const Result extend = run(dir.path(), 2, {"extend", "newton", "--set", "field.max=0.03"});
+  EXPECT_NE(extend.status, 0);
+  EXPECT_NE(extend.err.find("mresim extend cannot run over MPI processes"), std::string::npos)
+      << extend.err;
 
   const std::string pair =
       std::string(MRESIM_SOURCE_DIR) + "/examples/fig2_2_single_spring_axial.toml";
@@ -136,4 +139,53 @@ TEST(MpiRunCli, RefusesWhatCannotSplitOverProcesses) {
   EXPECT_NE(two_dipole.err.find("cannot split a run over MPI processes"), std::string::npos)
       << two_dipole.err;
   EXPECT_FALSE(fs::exists(dir / "pair"));
+}
+
+// SIGTERM to mpirun (a scheduler's stop): both processes stop at the same step boundary and
+// process 0 writes the checkpoint; `mpirun -np 2 mresim resume` continues it, the other process
+// reading the same checkpoint, to results bitwise those of an uninterrupted two-process run.
+TEST(MpiRunCli, StoppedRunResumesOverProcessesToTheSameResults) {
+  if (!have_mpirun()) GTEST_SKIP() << "no MPI launcher (mpirun) found";
+  const TempDir dir;
+  // The whole small loop (11 steps, several seconds): long enough to stop in the middle.
+  const std::vector<std::string> args = {"run", kExample, "--out", "full", "--no-plot", "-j", "1"};
+  ASSERT_EQ(run(dir.path(), 2, args).status, 0);
+
+  std::vector<std::string> stopped = {"--allow-run-as-root",
+                                      "--oversubscribe",
+                                      "-np",
+                                      "2",
+                                      MRESIM_CLI_PATH,
+                                      "run",
+                                      kExample,
+                                      "--out",
+                                      "stopped",
+                                      "--no-plot",
+                                      "-j",
+                                      "1"};
+  const pid_t pid =
+      mresim::testing::start_child(MRESIM_MPIEXEC, stopped, dir.path(), ".stdout", ".stderr-bg");
+  // Once the run is under way (its second step reported): a signal while mpirun is still
+  // starting the processes may end them at once, as for any MPI job.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (read_text(dir / ".stderr-bg").find("step 2/11") == std::string::npos &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ::kill(pid, SIGTERM);
+  EXPECT_NE(mresim::testing::wait_child(pid), 0);
+  const std::string err = read_text(dir / ".stderr-bg");
+  ASSERT_NE(err.find("mresim: interrupted by SIGTERM after step "), std::string::npos) << err;
+  ASSERT_FALSE(fs::exists(dir / "stopped"));
+
+  const Result resumed = run(dir.path(), 2, {"resume", "stopped", "--no-plot", "-j", "1"});
+  ASSERT_EQ(resumed.status, 0) << resumed.err;
+  EXPECT_NE(resumed.err.find("resuming at step"), std::string::npos) << resumed.err;
+  const Hdf5Reader a(dir / "full" / "results.h5");
+  const Hdf5Reader b(dir / "stopped" / "results.h5");
+  for (const char* path : {"/steps/centres", "/steps/magnetization", "/steps/energies/total",
+                           "/steps/energies/springs", "/steps/solver/max_force"}) {
+    EXPECT_EQ(a.doubles(path), b.doubles(path)) << path;
+  }
+  EXPECT_EQ(a.ints("/steps/solver/iterations"), b.ints("/steps/solver/iterations"));
 }

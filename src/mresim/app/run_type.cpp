@@ -34,7 +34,7 @@ void register_run_type(RunType type) {
   types.insert(position, std::move(type));
 }
 
-void RunPlan::participate() const {
+void RunPlan::participate(const std::filesystem::path& /*staging_dir*/) const {
   throw std::logic_error("RunPlan::participate: this run type does not split over processes");
 }
 

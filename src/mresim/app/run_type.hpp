@@ -31,12 +31,14 @@ class RunPlan {
   virtual void execute(const std::filesystem::path& staging_dir, io::Hdf5File& results,
                        Progress& progress) const = 0;
 
-  // `mpirun -np P mresim run` with P > 1 (docs/mpi.md) needs a plan that splits its work over
-  // the processes: rank 0 calls execute(), every other process calls participate() at the
-  // same time (the same computation, writing nothing). Plans that cannot keep these defaults;
-  // the command then refuses to run under mpirun.
+  // `mpirun -np P mresim run` (or `resume`) with P > 1 (docs/mpi.md) needs a plan that splits
+  // its work over the processes: rank 0 calls execute(), every other process calls
+  // participate() at the same time (the same computation, writing nothing); `staging_dir` is
+  // rank 0's staging directory when it resumes from a checkpoint there, else empty. Plans that
+  // cannot keep these defaults; the commands then refuse to run under mpirun.
   [[nodiscard]] virtual bool splits_over_processes() const { return false; }
-  virtual void participate() const;  // default: throws std::logic_error
+  // Default: throws std::logic_error.
+  virtual void participate(const std::filesystem::path& staging_dir) const;
 };
 
 // Reads and validates the run type's own tables from the whole document and returns the plan.

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdlib>
+#include <string>
 
 #include "mresim/mess/solvers/amg_preconditioner.hpp"
 
@@ -32,6 +33,16 @@ bool any_process(bool flag) {
   int any = 0;
   MPI_Allreduce(&mine, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
   return any != 0;
+}
+
+std::string broadcast_text(const std::string& text) {
+  if (mpi_job().size == 1) return text;
+  long long length = static_cast<long long>(text.size());
+  MPI_Bcast(&length, 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
+  std::string out = text;
+  out.resize(static_cast<std::size_t>(length));
+  MPI_Bcast(out.data(), static_cast<int>(length), MPI_CHAR, 0, MPI_COMM_WORLD);
+  return out;
 }
 
 void abort_job(int status) {

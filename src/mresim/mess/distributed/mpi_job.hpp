@@ -4,6 +4,8 @@
 // processes, the 3D runs split every relaxation's evaluations over them; rank 0 does
 // everything else (files, messages) and the others compute alongside it.
 
+#include <string>
+
 namespace mresim::mess {
 
 struct MpiJob {
@@ -22,6 +24,9 @@ MpiJob mpi_job();
 // Whether every process of the job has `flag` set (collective when the job has more than one
 // process: all must call it at the same point).
 bool any_process(bool flag);
+
+// Collective: rank 0's `text` on every process (unchanged when the job has one process).
+std::string broadcast_text(const std::string& text);
 
 // Ends every process of the job with `status` (MPI_Abort): for an error on one process while
 // the others may be waiting for it. Returns only when the job has one process.

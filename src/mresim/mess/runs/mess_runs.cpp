@@ -69,11 +69,6 @@ class MessPlan final : public app::RunPlan {
     ProtocolRunner runner(spec_);
     const fs::path checkpoint = staging_dir / kCheckpointFile;
     const bool split = split_over_processes(runner);
-    if (split && fs::exists(checkpoint)) {
-      throw std::invalid_argument(
-          "resuming a run over MPI processes is not supported yet; resume it with one process "
-          "(mresim resume without mpirun)");
-    }
     ProtocolState state = fs::exists(checkpoint) ? read_checkpoint(checkpoint, runner, input_toml_)
                                                  : runner.initial_state();
     const std::size_t total = runner.steps().size();
@@ -135,11 +130,15 @@ class MessPlan final : public app::RunPlan {
   }
 
   // The other processes of `mpirun -np P`: execute()'s computation, collectively with it,
-  // writing nothing (a resumed run is refused by execute(), on rank 0).
-  void participate() const override {
+  // writing nothing; a resumed run starts from the checkpoint in rank 0's staging directory,
+  // as execute() does.
+  void participate(const fs::path& staging_dir) const override {
     ProtocolRunner runner(spec_);
     (void)split_over_processes(runner);
-    ProtocolState state = runner.initial_state();
+    const fs::path checkpoint = staging_dir.empty() ? fs::path() : staging_dir / kCheckpointFile;
+    ProtocolState state = !checkpoint.empty() && fs::exists(checkpoint)
+                              ? read_checkpoint(checkpoint, runner, input_toml_)
+                              : runner.initial_state();
     const std::size_t total = runner.steps().size();
     while (state.next_step < total) {
       (void)runner.run_next_step(state);
