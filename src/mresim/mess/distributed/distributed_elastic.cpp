@@ -77,7 +77,7 @@ DistributedElastic::DistributedElastic(const lattice::Lattice& lattice,
     const std::array<int, 3> second = shape.node_coordinates(springs.second[s]);
     const std::array<int, 3> step = {second[0] - first[0], second[1] - first[1],
                                      second[2] - first[2]};
-    const auto offset =
+    const auto* const offset =
         std::find(lattice::kForwardNeighbours.begin(), lattice::kForwardNeighbours.end(), step);
     if (offset == lattice::kForwardNeighbours.end()) {
       throw std::invalid_argument("DistributedElastic: spring " + std::to_string(s) +

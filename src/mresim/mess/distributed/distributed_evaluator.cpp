@@ -29,7 +29,7 @@ void DistributedEvaluator::bind(MessSystem& system) {
 Evaluation DistributedEvaluator::evaluate(MessSystem& system, Eigen::Matrix3Xd* gradient) {
   bind(system);
   decomposition_->scatter(system.positions(), positions_);
-  const Evaluation e = system_->evaluate(positions_, gradient != nullptr ? gradient_ : nullptr);
+  Evaluation e = system_->evaluate(positions_, gradient != nullptr ? gradient_ : nullptr);
   if (gradient != nullptr) *gradient = decomposition_->gather(gradient_);
   return e;
 }

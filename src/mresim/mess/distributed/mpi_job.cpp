@@ -37,7 +37,7 @@ bool any_process(bool flag) {
 
 std::string broadcast_text(const std::string& text) {
   if (mpi_job().size == 1) return text;
-  long long length = static_cast<long long>(text.size());
+  auto length = static_cast<long long>(text.size());
   MPI_Bcast(&length, 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
   std::string out = text;
   out.resize(static_cast<std::size_t>(length));
