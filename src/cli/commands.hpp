@@ -1,6 +1,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <exception>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -54,6 +55,10 @@ int execute_and_publish(const config::TableReader& root, const app::RunPlan& pla
 int participate_in_run(const config::TableReader& root, const app::RunPlan& plan,
                        long threads_option, const mess::MpiJob& job,
                        const std::filesystem::path& staging_dir);
+// Under mpirun with P > 1, for an error on this process: prints it and ends every process of
+// the job (MPI_Abort), since the others may be waiting for this one in a collective call;
+// returns at once for a single process (the caller rethrows).
+void end_job_on_error(const std::exception& error, const mess::MpiJob& job);
 // Under mpirun with P > 1: throws std::invalid_argument unless the plan splits over processes.
 void refuse_unsplittable_plan(const app::RunPlan& plan, const std::string& run_type);
 

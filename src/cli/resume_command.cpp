@@ -3,7 +3,6 @@
 // run file stored in the checkpoint and lets the run type continue from there. Only run types
 // that write checkpoints (the 3D runs, [output] checkpoint_every) can be resumed.
 
-#include <fmt/format.h>
 #include <toml++/toml.h>
 
 #include <cstdio>
@@ -118,12 +117,7 @@ int resume_command(const ResumeOptions& options) {
     return execute_and_publish(root, *plan, run_type, *run_dir, options.threads, options.no_plot,
                                job);
   } catch (const std::exception& e) {
-    // The other processes may be waiting for this one (for the staging directory or in a
-    // collective call): end them all.
-    if (job.size > 1) {
-      app::run_output().error(fmt::format("mresim: error: {}", e.what()));
-      mess::abort_job(kFailure);
-    }
+    end_job_on_error(e, job);  // the others may wait for the staging directory or a collective
     throw;
   }
 }

@@ -79,14 +79,17 @@ int run_command(const RunOptions& options) {
     return execute_and_publish(root, *plan, run_type, run_dir, options.threads, options.no_plot,
                                job);
   } catch (const std::exception& e) {
-    // Under mpirun the other processes may be waiting for this one in a collective call:
-    // end them all (an exit status from here, with the message, never a hang).
-    if (job.size > 1) {
-      app::run_output().error(fmt::format("mresim: error: {}", e.what()));
-      mess::abort_job(kFailure);
-    }
+    end_job_on_error(e, job);
     throw;
   }
+}
+
+void end_job_on_error(const std::exception& error, const mess::MpiJob& job) {
+  if (job.size == 1) return;
+  app::run_output().error(
+      job.rank == 0 ? fmt::format("mresim: error: {}", error.what())
+                    : fmt::format("mresim: error on MPI process {}: {}", job.rank, error.what()));
+  mess::abort_job(kFailure);
 }
 
 void refuse_mpi_job(const char* command) {
@@ -120,8 +123,7 @@ int participate_in_run(const config::TableReader& root, const app::RunPlan& plan
   try {
     plan.participate(staging_dir);
   } catch (const std::exception& e) {
-    app::run_output().error(fmt::format("mresim: error on MPI process {}: {}", job.rank, e.what()));
-    mess::abort_job(kFailure);
+    end_job_on_error(e, job);
     throw;
   }
   return kSuccess;
