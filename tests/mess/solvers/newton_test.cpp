@@ -235,6 +235,31 @@ TEST(MessNewton, ConvergesWhereThePairDrawsTogether) {
   EXPECT_LT((c.col(1) - c.col(0)).norm(), s0 - 0.01 * sys.length_scale());
 }
 
+// The same pair drawn together from a multigrid built at the start: once the gap has been
+// squeezed, CG slows down with that multigrid, and it is rebuilt where the pair now is; the
+// state reached is the same as with the first multigrid kept throughout, in fewer CG
+// iterations.
+TEST(MessNewton, RebuildsTheMultigridWhenConjugateGradientsSlowDown) {
+  mess::MessSystem rebuilt = pair_in_field();
+  mess::MessSystem kept = rebuilt;
+  mess::MinimiserOptions opt;
+  opt.force_tolerance = 1e-9;
+  opt.method = mess::MinimiserMethod::newton;
+  opt.newton_cache = std::make_shared<mess::NewtonCache>();
+  const mess::MinimiserResult r = mess::minimise(rebuilt, opt);
+  ASSERT_TRUE(r.converged) << mess::to_string(r.status);
+  EXPECT_GE(opt.newton_cache->setups, 2);
+
+  opt.newton_cache = std::make_shared<mess::NewtonCache>();
+  opt.newton.multigrid_rebuild_slowdown = 0.0;
+  const mess::MinimiserResult k = mess::minimise(kept, opt);
+  ASSERT_TRUE(k.converged) << mess::to_string(k.status);
+  EXPECT_EQ(opt.newton_cache->setups, 1);
+  EXPECT_LT(r.krylov_iterations, k.krylov_iterations);
+  EXPECT_LT((rebuilt.particle_centres() - kept.particle_centres()).cwiseAbs().maxCoeff(),
+            1e-6 * rebuilt.length_scale());
+}
+
 TEST(MessNewton, SeedProfileAndRigidGroupRelax) {
   {
     mess::MessSystem a = pair_in_field("seed");
@@ -284,11 +309,13 @@ TEST(MessNewton, CacheKeepsTheMultigridAcrossCallsWithTheSameConstraints) {
   opt.force_tolerance = 1e-9;
   opt.newton_cache = std::make_shared<mess::NewtonCache>();
   ASSERT_TRUE(mess::minimise(sys, opt).converged);
-  EXPECT_EQ(opt.newton_cache->setups, 1);
+  // Built at the start, and again once the pair had drawn together (the test above).
+  const int first_call_setups = opt.newton_cache->setups;
+  EXPECT_GE(first_call_setups, 1);
   sys.set_applied_field(tesla(0.0, 0.0, 0.04));
   const mess::MinimiserResult reused = mess::minimise(sys, opt);
   ASSERT_TRUE(reused.converged);
-  EXPECT_EQ(opt.newton_cache->setups, 1);
+  EXPECT_EQ(opt.newton_cache->setups, first_call_setups);
   EXPECT_EQ(reused.preconditioner_seconds, 0.0);
   // The same two steps with a multigrid built for each call end in the same state.
   mess::MinimiserOptions own = opt;
@@ -303,5 +330,5 @@ TEST(MessNewton, CacheKeepsTheMultigridAcrossCallsWithTheSameConstraints) {
   c.fix_face(sys.lattice().shape, lat::Face::top, sys.positions());
   sys.set_constraints(c);
   ASSERT_TRUE(mess::minimise(sys, opt).converged);
-  EXPECT_EQ(opt.newton_cache->setups, 2);
+  EXPECT_GE(opt.newton_cache->setups, first_call_setups + 1);
 }

@@ -381,7 +381,6 @@ class Minimisation {
     res_.max_force = measure_.max_force(f_.full_gradient());
     res_.evaluations = f_.evaluations();
     if (newton_ != nullptr) {
-      newton_->finish();
       res_.krylov_iterations = newton_->krylov_iterations();
       res_.preconditioner_seconds = newton_->preconditioner_seconds();
       res_.multigrid_seconds = newton_->timings().multigrid;

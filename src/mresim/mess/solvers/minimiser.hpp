@@ -90,6 +90,10 @@ struct NewtonOptions {
   int max_krylov_iterations = 1000;  // CG iterations per Newton step
   // CG's relative residual: min(forcing_max, sqrt(max |g|)) with g the scaled gradient.
   double forcing_max = 0.1;
+  // The multigrid is rebuilt at the current positions before the next Newton step when a CG
+  // solve needs more than this many times the iterations per decade of residual reduction of
+  // the first solve after the build (plus 2); 0: rebuilt only when the constraints change.
+  double multigrid_rebuild_slowdown = 2.0;
   AmgOptions amg;
 };
 

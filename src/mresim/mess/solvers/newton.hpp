@@ -20,8 +20,9 @@
 // Preconditioner: one GAMG V-cycle on the elastic Hessian (the coordinates that are dofs of
 // their own; held coordinates and rigid-group nodes decoupled as identity), plus Jacobi for
 // the rigid groups' translations, corrected by the positive part of the centre term (the stiff
-// WCA contact) with the Woodbury identity. The multigrid is built once per run (NewtonCache);
-// the correction once per Newton step (3 N_p V-cycles).
+// WCA contact) with the Woodbury identity. The multigrid is built once per run (NewtonCache)
+// and rebuilt where CG slows down (note_convergence); the correction once per Newton step
+// (3 N_p V-cycles).
 //
 // The Hessian is always the conservative one (centres = mean of all particle nodes). With the
 // seed's CentreRule::centre_voxel, whose forces are not exactly a gradient, minimise() runs
@@ -63,17 +64,21 @@ struct NewtonPreconditioner {
   std::unique_ptr<ElasticMatrix> matrix;
   std::unique_ptr<AmgPreconditioner> amg;
   Eigen::VectorXd group_diagonal;  // H's diagonal on the rigid groups' translations
-  // CG iterations per Newton step in the first minimise() call that used it; a later call
-  // needing more than twice that (plus 10) marks it stale, and the next call rebuilds it at
-  // its own starting positions.
-  double baseline_krylov_per_step = -1.0;
+  // How fast CG converged with it: the most iterations per decade of residual reduction in
+  // the first three solves after it was built. A later solve more than
+  // NewtonOptions::multigrid_rebuild_slowdown times as slow (plus 2) marks it stale, and it is
+  // rebuilt at the current positions before the next Newton step.
+  double fresh_iterations_per_decade = 0.0;
+  int reference_solves = 0;
   bool stale = false;
 };
 
 // Kept by a caller between minimise() calls (MinimiserOptions::newton_cache) so that the
 // multigrid, whose setup costs about as much as 20-40 CG iterations, is built once per run
 // rather than once per field or strain step: the elastic Hessian changes little between steps,
-// and a preconditioner need only be close. Rebuilt when the constraints change or it is stale.
+// and a preconditioner need only be close. Rebuilt when the constraints change, and whenever
+// CG's convergence shows that the configuration has moved too far from the one it was built
+// at (a pair snapping into contact: the gap between the particles is squeezed, springs turn).
 struct NewtonCache {
   std::unique_ptr<NewtonPreconditioner> current;
   int setups = 0;
@@ -92,9 +97,6 @@ class NewtonSolver {
   // Newton steps from u until `converged`, the budget (Newton steps) or a failure.
   InnerResult run(Objective& f, Eigen::VectorXd& u, int budget, const MinimiserOptions& options,
                   bool use_energy, const ConvergenceTest& converged);
-  // At the end of a minimise() call: judges whether the kept multigrid has gone stale.
-  void finish();
-
   std::int64_t krylov_iterations() const { return krylov_iterations_; }
   int newton_steps() const { return newton_steps_; }
   double preconditioner_seconds() const { return setup_seconds_; }
@@ -109,6 +111,10 @@ class NewtonSolver {
 
  private:
   void build_preconditioner();
+  // Records how fast one CG solve converged: `iterations` to reduce the residual by the
+  // factor `reduction` (< 1). Marks the multigrid stale if it converged much slower than the
+  // first solve after the build (NewtonPreconditioner::fresh_iterations_per_decade).
+  void note_convergence(int iterations, double reduction);
   // One V-cycle on the elastic part (plus Jacobi on the rigid groups).
   Eigen::VectorXd elastic_precondition(const Eigen::VectorXd& r) const;
   // The centre term's positive part in the preconditioner, by the Woodbury identity.
