@@ -191,7 +191,25 @@ Eigen::VectorXd NewtonSolver::elastic_precondition(const Eigen::VectorXd& r) con
   return z;
 }
 
-Eigen::VectorXd NewtonSolver::newton_direction(const Eigen::VectorXd& g, double eta) {
+namespace {
+
+// The largest tau >= 0 with |x + tau p|_inf <= radius, for x inside that box.
+double distance_to_boundary(const Eigen::VectorXd& x, const Eigen::VectorXd& p, double radius) {
+  double tau = std::numeric_limits<double>::infinity();
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    if (p[i] > 0.0) {
+      tau = std::min(tau, (radius - x[i]) / p[i]);
+    } else if (p[i] < 0.0) {
+      tau = std::min(tau, (-radius - x[i]) / p[i]);
+    }
+  }
+  return std::max(tau, 0.0);
+}
+
+}  // namespace
+
+NewtonDirection NewtonSolver::newton_direction(const Eigen::VectorXd& g, double eta,
+                                               double radius) {
   // Vector algebra on both cores, independent of the thread count (vector_algebra.hpp).
   Eigen::VectorXd x = Eigen::VectorXd::Zero(g.size());
   Eigen::VectorXd r = -g;
@@ -200,15 +218,19 @@ Eigen::VectorXd NewtonSolver::newton_direction(const Eigen::VectorXd& g, double 
   double rz = parallel_dot(r, z);
   const double g_norm = std::sqrt(parallel_dot(g, g));
   const double target = eta * g_norm;
+  // Steihaug: leaving the box |x|_inf <= radius, or along a direction of non-positive
+  // curvature, the step ends on the box's boundary.
+  const auto to_boundary = [&]() {
+    parallel_axpy(distance_to_boundary(x, p, radius), p, x);
+    return NewtonDirection{std::move(x), true};
+  };
   for (int k = 0; k < options_.max_krylov_iterations; ++k) {
     const Eigen::VectorXd hp = hessian_product(p);
     ++krylov_iterations_;
     const double curvature = parallel_dot(p, hp);
-    if (!(curvature > 0.0)) {
-      // Negative curvature: the iterate so far, or the preconditioned steepest descent.
-      return k == 0 ? p : x;
-    }
+    if (!(curvature > 0.0)) return to_boundary();
     const double alpha = rz / curvature;
+    if ((x + alpha * p).cwiseAbs().maxCoeff() > radius) return to_boundary();
     parallel_axpy(alpha, p, x);
     const double residual = std::sqrt(parallel_axpy_dot(-alpha, hp, r, r));
     if (residual <= target) {
@@ -221,7 +243,7 @@ Eigen::VectorXd NewtonSolver::newton_direction(const Eigen::VectorXd& g, double 
     parallel_scale_add(rz_next / rz, z, p);
     rz = rz_next;
   }
-  return x;
+  return {std::move(x), false};
 }
 
 InnerResult NewtonSolver::run(Objective& f, Eigen::VectorXd& u, int budget,
@@ -261,14 +283,17 @@ InnerResult NewtonSolver::run(Objective& f, Eigen::VectorXd& u, int budget,
                : std::min(options_.forcing_max,
                           std::max(std::sqrt(gmax), 0.5 * options.force_tolerance / gmax));
     // After a failed line search: one preconditioned steepest-descent step.
-    Eigen::VectorXd d =
-        failures > 0 ? Eigen::VectorXd(-precondition(cur.g)) : newton_direction(cur.g, eta);
+    NewtonDirection direction = failures > 0 ? NewtonDirection{-precondition(cur.g), false}
+                                             : newton_direction(cur.g, eta, step_cap);
+    Eigen::VectorXd& d = direction.step;
     cur.dphi = cur.g.dot(d);
     if (!(cur.dphi < 0.0)) {
       d = -precondition(cur.g);
+      direction.on_boundary = false;
       cur.dphi = cur.g.dot(d);
     }
-    const double alpha_max = step_cap / d.cwiseAbs().maxCoeff();
+    // A step on the boundary reaches the cap at alpha = 1 (up to rounding).
+    const double alpha_max = direction.on_boundary ? 1.0 : step_cap / d.cwiseAbs().maxCoeff();
     LinePoint next;
     const bool ok = wolfe_line_search(f, u, d, cur, 1.0, alpha_max, use_energy, next);
     ++r.iterations;
@@ -281,7 +306,7 @@ InnerResult NewtonSolver::run(Objective& f, Eigen::VectorXd& u, int budget,
       continue;
     }
     failures = 0;
-    capped = alpha_max < 1.0 && next.alpha >= alpha_max;
+    capped = (direction.on_boundary || alpha_max < 1.0) && next.alpha >= std::min(1.0, alpha_max);
     if (capped) {
       step_cap = std::min(1.5 * step_cap, kStepGrowth * options.max_step);
     } else if (next.alpha < 0.5 * std::min(1.0, alpha_max)) {

@@ -4,9 +4,11 @@
 // search Newton method whose steps are solved by conjugate gradients on the exact Hessian,
 // preconditioned by algebraic multigrid (amg_preconditioner.hpp). Truncated Newton (Nocedal &
 // Wright, Numerical Optimization, Alg. 7.1): CG stops at the relative residual
-// eta = min(forcing_max, sqrt(|g|_inf)) (superlinear convergence), or at the first direction of
-// non-positive curvature, and returns its iterate so far (the preconditioned gradient if that
-// happens at the first step).
+// eta = min(forcing_max, sqrt(|g|_inf)) (superlinear convergence). The step cap (the largest
+// coordinate change, in l_e) bounds CG's path as a trust region does (Steihaug-Toint, ibid.
+// Alg. 7.2, in the max norm): at a direction of non-positive curvature, or where the path
+// leaves the box, the step goes on along that direction to the box's boundary. The line
+// search then judges the step, and the cap grows after boundary steps accepted whole.
 //
 // The Hessian, in the free variables (scaled like the minimisers', relaxation_common.hpp):
 //   H = P^T (H_elastic + S^T K_c S) P / F0
@@ -88,6 +90,13 @@ struct NewtonCache {
 
 namespace mresim::mess::detail {
 
+// A Newton step in the scaled free variables, and whether CG stopped it on the box of the step
+// cap (a direction of non-positive curvature, or the path leaving the box).
+struct NewtonDirection {
+  Eigen::VectorXd step;
+  bool on_boundary = false;
+};
+
 class NewtonSolver {
  public:
   // `cache`: where the multigrid is kept (null: built for this solver alone).
@@ -119,9 +128,10 @@ class NewtonSolver {
   Eigen::VectorXd elastic_precondition(const Eigen::VectorXd& r) const;
   // The centre term's positive part in the preconditioner, by the Woodbury identity.
   void update_woodbury();
-  // d ~ -H^-1 g by preconditioned CG to |r| <= eta |g|, truncated at negative curvature (then
-  // the iterate so far, or the preconditioned steepest descent at the first direction).
-  Eigen::VectorXd newton_direction(const Eigen::VectorXd& g, double eta);
+  // d ~ -H^-1 g by preconditioned CG to |r| <= eta |g| inside the box |d|_inf <= radius
+  // (Steihaug-Toint): where CG's path leaves the box or meets non-positive curvature, the
+  // step goes on along that CG direction to the box's boundary.
+  NewtonDirection newton_direction(const Eigen::VectorXd& g, double eta, double radius);
 
   MessSystem& system_;
   const DofMap& map_;
