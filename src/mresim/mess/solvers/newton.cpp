@@ -263,11 +263,15 @@ InnerResult NewtonSolver::run(Objective& f, Eigen::VectorXd& u, int budget,
   constexpr int kStallIterations = 20;
   StallGuard guard(cur.g, kStallIterations);
   int failures = 0;
-  // The largest coordinate change of a step (units of l_e), like a trust radius: max_step at
-  // first, grown by half (up to kStepGrowth max_step) after a step that the cap cut short and that
-  // was accepted whole, halved (down to max_step) after one the line search had to shorten. A pair
-  // snapping into contact moves ~10 l_e, which steps of 0.2 l_e would take 50 Newton steps for.
+  // The largest coordinate change of a step (units of l_e), the trust radius of CG's path:
+  // max_step at first, grown by half (up to kStepGrowth max_step) after a step that reached it
+  // and was accepted whole, halved (down to kStepShrink max_step) after one the line search had
+  // to shorten. A pair snapping into contact moves ~10 l_e, which steps of 0.2 l_e would take 50
+  // Newton steps for; in contact, directions of negative curvature (the pair tilting off the
+  // field axis by a few nm) need steps far below 0.2 l_e (with a floor of max_step, the small
+  // Fig. 4.11 loop needed 3,145 CG iterations; with max_step/64, 2,269; docs/performance.md).
   constexpr double kStepGrowth = 16.0;
+  constexpr double kStepShrink = 1.0 / 64.0;
   double step_cap = options.max_step;
   bool capped = false;  // the last step was cut short by the cap: its direction was far off
   while (r.iterations < budget) {
@@ -310,7 +314,7 @@ InnerResult NewtonSolver::run(Objective& f, Eigen::VectorXd& u, int budget,
     if (capped) {
       step_cap = std::min(1.5 * step_cap, kStepGrowth * options.max_step);
     } else if (next.alpha < 0.5 * std::min(1.0, alpha_max)) {
-      step_cap = std::max(0.5 * step_cap, options.max_step);
+      step_cap = std::max(0.5 * step_cap, kStepShrink * options.max_step);
     }
     u += next.alpha * d;
     r.energy_change = next.phi - cur.phi;
