@@ -42,9 +42,13 @@ pid_t start_mresim(const fs::path& dir, const std::vector<std::string>& args,
   return mresim::testing::start_child(MRESIM_CLI_PATH, args, dir, "/dev/null", ".stderr-" + tag);
 }
 
-// Starts `mresim run FILE --out OUT --no-plot -j 2` in `dir` without waiting for it.
+// Every run here uses one thread: ctest runs two tests at once on CI's two cores, and two
+// OpenMP threads per run, spinning while they wait, made the ten-kill test below take 139 s
+// there instead of 14 s. Results do not depend on the thread count (MessSolvers.
+// IndependentOfThreadCount), so one thread tests the same resume.
+// Starts `mresim run FILE --out OUT --no-plot -j 1` in `dir` without waiting for it.
 pid_t start_run(const fs::path& dir, const std::string& file, const std::string& out) {
-  return start_mresim(dir, {"run", file, "--out", out, "--no-plot", "-j", "2"});
+  return start_mresim(dir, {"run", file, "--out", out, "--no-plot", "-j", "1"});
 }
 
 // The step datasets two runs of the same file must agree on bit for bit.
@@ -78,7 +82,7 @@ TEST(MessResumeCli, KilledRunResumedGivesTheSameResults) {
   // 51 steps of a few tens of milliseconds each: killed a few steps after its first checkpoint.
   const std::string toml = mresim::mess_protocol::testing::small_hysteresis(0.2, 10);
   { std::ofstream(dir / "run.toml") << toml; }
-  ASSERT_EQ(mresim_status(dir.path(), "run run.toml --out full --no-plot -j 2"), 0);
+  ASSERT_EQ(mresim_status(dir.path(), "run run.toml --out full --no-plot -j 1"), 0);
 
   const pid_t pid = start_run(dir.path(), "run.toml", "killed");
   ASSERT_GT(pid, 0);
@@ -101,7 +105,7 @@ TEST(MessResumeCli, KilledRunResumedGivesTheSameResults) {
   ASSERT_TRUE(killed) << "the run finished or never checkpointed before it could be killed";
   ASSERT_FALSE(fs::exists(dir / "killed"));  // nothing published by the killed run
 
-  ASSERT_EQ(mresim_status(dir.path(), "resume killed --no-plot -j 2"), 0)
+  ASSERT_EQ(mresim_status(dir.path(), "resume killed --no-plot -j 1"), 0)
       << mresim::testing::read_text(dir / ".stderr");
   // It continued from the checkpoint rather than starting over.
   EXPECT_NE(mresim::testing::read_text(dir / ".stderr").find("resuming at step"),
@@ -121,7 +125,7 @@ TEST(MessResumeCli, SigtermWritesACheckpointAndTheResumedRunIsIdentical) {
   {
     std::ofstream(dir / "run.toml") << mresim::mess_protocol::testing::small_hysteresis(0.2, 4, 0);
   }
-  ASSERT_EQ(mresim_status(dir.path(), "run run.toml --out full --no-plot -j 2"), 0);
+  ASSERT_EQ(mresim_status(dir.path(), "run run.toml --out full --no-plot -j 1"), 0);
 
   const pid_t pid = start_mresim(dir.path(), {"run", "run.toml", "--out", "stopped", "--no-plot"});
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
@@ -138,7 +142,7 @@ TEST(MessResumeCli, SigtermWritesACheckpointAndTheResumedRunIsIdentical) {
   EXPECT_FALSE(fs::exists(dir / "stopped"));
   EXPECT_FALSE(fs::exists(dir / "stopped.mresim-lock"));
 
-  ASSERT_EQ(mresim_status(dir.path(), "resume stopped --no-plot -j 2"), 0)
+  ASSERT_EQ(mresim_status(dir.path(), "resume stopped --no-plot -j 1"), 0)
       << mresim::testing::read_text(dir / ".stderr");
   EXPECT_NE(mresim::testing::read_text(dir / ".stderr").find("resuming at step"),
             std::string::npos);
@@ -171,12 +175,12 @@ TEST(MessResumeCli, TenRandomKillsAndResumesGiveTheSameResults) {
   const TempDir dir;
   { std::ofstream(dir / "run.toml") << mresim::mess_protocol::testing::small_hysteresis(0.2, 4); }
   const auto t0 = std::chrono::steady_clock::now();
-  ASSERT_EQ(mresim_status(dir.path(), "run run.toml --out full --no-plot -j 2"), 0);
+  ASSERT_EQ(mresim_status(dir.path(), "run run.toml --out full --no-plot -j 1"), 0);
   const fs::path full = dir / "full";
   // The length of one uninterrupted run, from a run of our own if the shared one was made
   // earlier.
   if (std::chrono::steady_clock::now() - t0 < std::chrono::milliseconds(100)) {
-    ASSERT_EQ(mresim_status(dir.path(), "run run.toml --out timing --no-plot -j 2"), 0);
+    ASSERT_EQ(mresim_status(dir.path(), "run run.toml --out timing --no-plot -j 1"), 0);
   }
   const double full_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -189,7 +193,7 @@ TEST(MessResumeCli, TenRandomKillsAndResumesGiveTheSameResults) {
     // Continue from a checkpoint if the last kill left one, else start (again) from scratch.
     const pid_t pid = staged_checkpoint(dir.path(), "chain").empty()
                           ? start_run(dir.path(), "run.toml", "chain")
-                          : start_mresim(dir.path(), {"resume", "chain", "--no-plot", "-j", "2"});
+                          : start_mresim(dir.path(), {"resume", "chain", "--no-plot", "-j", "1"});
     if (kills < 10) {
       std::this_thread::sleep_for(
           std::chrono::duration<double, std::milli>(moment(random) * full_ms));
