@@ -42,10 +42,11 @@ pid_t start_mresim(const fs::path& dir, const std::vector<std::string>& args,
   return mresim::testing::start_child(MRESIM_CLI_PATH, args, dir, "/dev/null", ".stderr-" + tag);
 }
 
-// Every run here uses one thread: ctest runs two tests at once on CI's two cores, and two
-// OpenMP threads per run, spinning while they wait, made the ten-kill test below take 139 s
-// there instead of 14 s. Results do not depend on the thread count (MessSolvers.
-// IndependentOfThreadCount), so one thread tests the same resume.
+// The runs here use one thread (all but the SIGTERM test's stopped run, which keeps the
+// default): ctest runs two tests at once on CI's two cores, and two OpenMP threads per run,
+// spinning while they wait, made the ten-kill test below take 139 s there instead of 14 s.
+// Results do not depend on the thread count (MessSolvers.IndependentOfThreadCount), so one
+// thread tests the same resume.
 // Starts `mresim run FILE --out OUT --no-plot -j 1` in `dir` without waiting for it.
 pid_t start_run(const fs::path& dir, const std::string& file, const std::string& out) {
   return start_mresim(dir, {"run", file, "--out", out, "--no-plot", "-j", "1"});
