@@ -5,9 +5,11 @@
 // (max force 1e-6 k_eff l_e). Prints per size and method: nodes, wall and CPU time, outer
 // iterations (Newton or L-BFGS steps), inner iterations (CG), evaluations, and the agreement
 // of the final states; then the exponent p of time ~ N^p fitted over n_d = 2 ... 5 and the
-// time ratios lbfgs / newton measured in this run. docs/performance.md records the results.
+// time ratios lbfgs / newton measured in this run. Methods: newton, lbfgs (the default) and
+// lbfgs-mg (L-BFGS with Newton's multigrid as its initial inverse Hessian,
+// LbfgsPreconditioner::multigrid). docs/performance.md records the results.
 //
-//   ./build/mess_scaling_bench                      (seed profile, n_d = 1..5, both methods)
+//   ./build/mess_scaling_bench                      (seed profile, n_d = 1..5, all three methods)
 //   ./build/mess_scaling_bench --orders 1,2,3 --profile physical --lbfgs-max-order 3
 #include <sys/resource.h>
 
@@ -81,10 +83,13 @@ struct Outcome {
   Eigen::Matrix3Xd magnetizations;
 };
 
-Outcome relax(const mess::ModelProfile& profile, int order, mess::MinimiserMethod method) {
+Outcome relax(
+    const mess::ModelProfile& profile, int order, mess::MinimiserMethod method,
+    mess::LbfgsPreconditioner preconditioner = mess::LbfgsPreconditioner::rigid_particles) {
   mess::MessSystem sys = make_system(profile, order);
   mess::MinimiserOptions options;
   options.method = method;
+  options.lbfgs_preconditioner = preconditioner;
   Outcome o;
   const auto start = std::chrono::steady_clock::now();
   const double cpu0 = cpu_seconds();
@@ -99,20 +104,30 @@ Outcome relax(const mess::ModelProfile& profile, int order, mess::MinimiserMetho
 void print(int order, std::int64_t nodes, const char* method, const Outcome& o) {
   const mess::MinimiserResult& r = o.result;
   std::printf(
-      "n_d=%d %8lld nodes  %-6s  wall %8.2f s  cpu %8.2f s  outer %6d  inner %7lld  "
+      "n_d=%d %8lld nodes  %-8s  wall %8.2f s  cpu %8.2f s  outer %6d  inner %7lld  "
       "evaluations %7lld  setup %6.2f s  %s%s\n",
       order, static_cast<long long>(nodes), method, o.wall, o.cpu, r.iterations,
       static_cast<long long>(r.krylov_iterations), static_cast<long long>(r.evaluations),
       r.preconditioner_seconds, mess::to_string(r.status).c_str(),
       r.finished_with_lbfgs ? " (finished with lbfgs)" : "");
-  if (r.krylov_iterations > 0) {
+  if (r.multigrid_seconds > 0.0) {
     std::printf(
-        "        newton parts: multigrid %.2f s, Hessian products %.2f s, centre Hessians "
+        "        %s parts: multigrid %.2f s, Hessian products %.2f s, centre Hessians "
         "%.2f s, setup %.2f s\n",
-        r.multigrid_seconds, r.hessian_product_seconds, r.centre_hessian_seconds,
+        method, r.multigrid_seconds, r.hessian_product_seconds, r.centre_hessian_seconds,
         r.preconditioner_seconds);
   }
   std::fflush(stdout);
+}
+
+// The time ratio to newton measured in this run, and how far apart the final states are.
+void print_against_newton(const char* method, const Outcome& o, const Outcome& newton) {
+  std::printf(
+      "        %s/newton wall %.2fx, cpu %.2fx; max |centre difference| %.2e l_e, "
+      "max |M/Ms difference| %.2e\n",
+      method, o.wall / newton.wall, o.cpu / newton.cpu,
+      (o.centres - newton.centres).cwiseAbs().maxCoeff(),
+      (o.magnetizations - newton.magnetizations).cwiseAbs().maxCoeff());
 }
 
 // Least-squares slope of log t against log N.
@@ -147,6 +162,7 @@ int main(int argc, char** argv) {
   std::string profile_name = "seed";
   std::vector<int> orders = {1, 2, 3, 4, 5};
   int lbfgs_max_order = 5;
+  int multigrid_lbfgs_max_order = 5;
   for (int k = 1; k + 1 < argc; k += 2) {
     const std::string key = argv[k];
     if (key == "--profile") {
@@ -155,8 +171,13 @@ int main(int argc, char** argv) {
       orders = parse_orders(argv[k + 1]);
     } else if (key == "--lbfgs-max-order") {
       lbfgs_max_order = std::stoi(argv[k + 1]);
+    } else if (key == "--lbfgs-mg-max-order") {
+      multigrid_lbfgs_max_order = std::stoi(argv[k + 1]);
     } else {
-      std::fprintf(stderr, "unknown option %s (--profile, --orders, --lbfgs-max-order)\n", argv[k]);
+      std::fprintf(stderr,
+                   "unknown option %s (--profile, --orders, --lbfgs-max-order, "
+                   "--lbfgs-mg-max-order)\n",
+                   argv[k]);
       return 2;
     }
   }
@@ -168,6 +189,7 @@ int main(int argc, char** argv) {
   std::vector<double> nodes_fit;
   std::vector<double> newton_fit;
   std::vector<double> lbfgs_fit;
+  std::vector<double> multigrid_lbfgs_fit;
   for (const int order : orders) {
     const std::int64_t nodes = make_system(profile, order).node_count();
     const Outcome n = relax(profile, order, mess::MinimiserMethod::newton);
@@ -175,12 +197,15 @@ int main(int argc, char** argv) {
     if (order <= lbfgs_max_order) {
       const Outcome l = relax(profile, order, mess::MinimiserMethod::lbfgs);
       print(order, nodes, "lbfgs", l);
-      std::printf(
-          "        lbfgs/newton wall %.2fx, cpu %.2fx; max |centre difference| %.2e l_e, "
-          "max |M/Ms difference| %.2e\n",
-          l.wall / n.wall, l.cpu / n.cpu, (l.centres - n.centres).cwiseAbs().maxCoeff(),
-          (l.magnetizations - n.magnetizations).cwiseAbs().maxCoeff());
+      print_against_newton("lbfgs", l, n);
       if (order >= 2) lbfgs_fit.push_back(l.wall);
+    }
+    if (order <= multigrid_lbfgs_max_order) {
+      const Outcome m =
+          relax(profile, order, mess::MinimiserMethod::lbfgs, mess::LbfgsPreconditioner::multigrid);
+      print(order, nodes, "lbfgs-mg", m);
+      print_against_newton("lbfgs-mg", m, n);
+      if (order >= 2) multigrid_lbfgs_fit.push_back(m.wall);
     }
     if (order >= 2) {
       nodes_fit.push_back(static_cast<double>(nodes));
@@ -191,6 +216,9 @@ int main(int argc, char** argv) {
     std::printf("time ~ N^p over n_d >= 2: newton p = %.2f", exponent(nodes_fit, newton_fit));
     if (lbfgs_fit.size() == nodes_fit.size()) {
       std::printf(", lbfgs p = %.2f", exponent(nodes_fit, lbfgs_fit));
+    }
+    if (multigrid_lbfgs_fit.size() == nodes_fit.size()) {
+      std::printf(", lbfgs-mg p = %.2f", exponent(nodes_fit, multigrid_lbfgs_fit));
     }
     std::printf("\n");
   }

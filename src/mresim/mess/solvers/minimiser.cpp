@@ -60,6 +60,10 @@ void MinimiserOptions::validate() const {
   if (!(newton.forcing_max > 0.0 && newton.forcing_max < 1.0)) {
     fail("newton.forcing_max must be in (0, 1)");
   }
+  if (distributed != nullptr && method == MinimiserMethod::lbfgs && precondition &&
+      lbfgs_preconditioner == LbfgsPreconditioner::multigrid) {
+    fail("the multigrid preconditioner cannot split its work over MPI processes yet");
+  }
   if (distributed != nullptr && method == MinimiserMethod::newton) {
     fail("method newton cannot split its work over MPI processes yet (docs/mpi.md); use lbfgs");
   }
@@ -143,11 +147,12 @@ class LbfgsMemory {
   std::deque<double> rho_;
 };
 
+// `precondition`: P of H0 = gamma P (null: the identity).
 InnerResult run_lbfgs(Objective& f, Eigen::VectorXd& u, int budget, const MinimiserOptions& opt,
-                      const RigidParticlePreconditioner* precondition, bool use_energy,
+                      const LbfgsMemory::Preconditioner* precondition, bool use_energy,
                       const std::function<bool(const Eigen::VectorXd&, double)>& converged) {
   const LbfgsMemory::Preconditioner P = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
-    return precondition != nullptr ? precondition->apply(v) : v;
+    return precondition != nullptr ? (*precondition)(v) : v;
   };
   InnerResult r;
   LbfgsMemory memory;
@@ -357,7 +362,8 @@ class Minimisation {
         alternating_(alternating),
         budget_(options.max_iterations),
         method_(options.method) {
-    if (options.precondition && options.method != MinimiserMethod::fire) {
+    if (options.precondition && options.method != MinimiserMethod::fire &&
+        options.lbfgs_preconditioner == LbfgsPreconditioner::rigid_particles) {
       preconditioner_ = std::make_unique<RigidParticlePreconditioner>(system, map, force_scale);
     }
     res_.force_scale = force_scale;
@@ -420,15 +426,30 @@ class Minimisation {
     // Newton; in the seed's forces-only phase with the conservative neighbour's Hessian as the
     // Jacobian of the seed's forces (they differ by the particles' internal deformation).
     if (method_ == MinimiserMethod::newton) {
-      if (newton_ == nullptr) {
-        newton_ = std::make_unique<detail::NewtonSolver>(system_, map_, force_scale_, opt_.newton,
-                                                         opt_.newton_cache);
-      }
-      return newton_->run(f_, u_, budget_, opt_, use_energy_, test);
+      return newton_solver().run(f_, u_, budget_, opt_, use_energy_, test);
     }
-    return method_ != MinimiserMethod::fire
-               ? run_lbfgs(f_, u_, budget_, opt_, preconditioner_.get(), use_energy_, test)
-               : run_fire(f_, rules_, u_, budget_, opt_, mass_, test);
+    if (method_ == MinimiserMethod::fire) {
+      return run_fire(f_, rules_, u_, budget_, opt_, mass_, test);
+    }
+    LbfgsMemory::Preconditioner P;
+    if (preconditioner_ != nullptr) {
+      P = [this](const Eigen::VectorXd& v) { return preconditioner_->apply(v); };
+    } else if (opt_.precondition) {
+      // Newton's multigrid; its contact correction at the state this inner run starts from.
+      detail::NewtonSolver& newton = newton_solver();
+      newton.update_centre_hessian();
+      P = [&newton](const Eigen::VectorXd& v) { return newton.precondition(v); };
+    }
+    return run_lbfgs(f_, u_, budget_, opt_, P ? &P : nullptr, use_energy_, test);
+  }
+
+  // Newton's solver (newton.hpp), built on first use: the method, or L-BFGS's multigrid.
+  detail::NewtonSolver& newton_solver() {
+    if (newton_ == nullptr) {
+      newton_ = std::make_unique<detail::NewtonSolver>(system_, map_, force_scale_, opt_.newton,
+                                                       opt_.newton_cache);
+    }
+    return *newton_;
   }
 
   // One outer iteration; false ends the loop.

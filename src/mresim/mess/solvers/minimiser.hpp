@@ -63,6 +63,15 @@
 namespace mresim::mess {
 
 enum class MinimiserMethod { lbfgs, fire, newton };
+// L-BFGS's initial inverse Hessian H0 = gamma P:
+//  rigid_particles: RigidParticlePreconditioner (preconditioner.hpp), the default;
+//  multigrid: Newton's preconditioner (newton.hpp: one GAMG V-cycle on the elastic Hessian
+//    with the contact term's Woodbury correction). Measured in docs/performance.md: L-BFGS's
+//    iterations stay at 58-93 from 5k to 49k nodes (not 218-2,236), but a V-cycle costs
+//    about 12 evaluations at 16k nodes and 46 at 285k (serial PETSc), so it beat the
+//    default only at 49k nodes (1.23x) and Newton nowhere. Kept to measure the route
+//    (mess_scaling_bench); not offered in run files.
+enum class LbfgsPreconditioner { rigid_particles, multigrid };
 enum class MagnetizationCoupling { alternating, every_evaluation };
 // stalled: 50 L-BFGS iterations without a new smallest force or an energy decrease beyond
 // rounding (the tolerance is below what the configuration's rounding allows).
@@ -111,8 +120,9 @@ struct MinimiserOptions {
   int max_outer_iterations = 50;
   MagnetizationCoupling coupling = MagnetizationCoupling::every_evaluation;
   int lbfgs_memory = 10;
-  // L-BFGS only: initial inverse Hessian from RigidParticlePreconditioner (preconditioner.hpp).
+  // L-BFGS only: initial inverse Hessian from `lbfgs_preconditioner` (false: the identity).
   bool precondition = true;
+  LbfgsPreconditioner lbfgs_preconditioner = LbfgsPreconditioner::rigid_particles;
   double max_step = 0.2;  // largest coordinate change per iteration, in units of l_e
   FireParameters fire;
   NewtonOptions newton;
