@@ -140,6 +140,45 @@ TEST(MessNewton, ReducedCentreHessianMatchesDifferencesOfTheCentreGradient) {
   EXPECT_LT(k(5, 5), 0.0);
 }
 
+// The constant load of the seed's correction passes (minimiser.cpp): the loaded objective's
+// gradient is the plain one plus the load on the free variables, its potential grows by
+// load . (x - x(u_ref)) (so central differences of it match the gradient), and clear_load()
+// gives the plain objective back.
+TEST(MessObjective, ConstantLoadAddsItsGradientAndItsWork) {
+  mess::MessSystem sys = pair_in_field();
+  sys.settings().magnetization_update = mess::MagnetizationUpdate::every_evaluation;
+  sys.set_positions(perturbed(sys.positions(), 0.02 * sys.length_scale()));
+  const double f0 = mess::LeapfrogScales::of(sys.lattice()).k_eff * sys.length_scale();
+  const mess::DofMap map(sys.constraints(), sys.positions(), sys.length_scale());
+  mess::detail::Objective f(sys, map, f0);
+  const Eigen::VectorXd u = map.to_dofs(sys.positions());
+  Eigen::VectorXd plain;
+  const double phi_plain = f(u, plain);
+  const Eigen::Matrix3Xd plain_full = f.full_gradient();
+  // A load on every node (3 x N, J/m), of the size of F0, as the seed's centre forces are.
+  const Eigen::Matrix3Xd load = perturbed(Eigen::Matrix3Xd::Zero(3, sys.node_count()), f0);
+  const Eigen::VectorXd u_ref = u + 0.1 * Eigen::VectorXd::Ones(u.size());
+  f.set_load(load, u_ref);
+  Eigen::VectorXd loaded;
+  const double phi_loaded = f(u, loaded);
+  const Eigen::VectorXd load_dofs = map.reduce(load) / f.energy_scale();
+  EXPECT_LT(max_abs(loaded - plain - load_dofs), 1e-12 * max_abs(plain));
+  EXPECT_NEAR(phi_loaded - phi_plain, load_dofs.dot(u - u_ref), 1e-12 * std::abs(phi_plain));
+  EXPECT_LT((f.full_gradient() - plain_full - load).cwiseAbs().maxCoeff(), 1e-12 * f0);
+  // Central differences of the loaded potential along a direction of unit size.
+  const Eigen::Matrix3Xd unit = perturbed(Eigen::Matrix3Xd::Zero(3, sys.node_count()), 1.0, 11);
+  const Eigen::VectorXd v = map.reduce(unit) / sys.length_scale();  // up to 1 per dof
+  const double h = 1e-5;
+  Eigen::VectorXd scratch;
+  const double slope = (f(u + h * v, scratch) - f(u - h * v, scratch)) / (2 * h);
+  EXPECT_NEAR(slope, loaded.dot(v), 1e-5 * std::abs(loaded.dot(v)));
+  f.clear_load();
+  Eigen::VectorXd again;
+  // (M is re-solved from where the last evaluation left it: equal to its tolerance.)
+  EXPECT_NEAR(f(u, again), phi_plain, 1e-12 * std::abs(phi_plain));
+  EXPECT_LT(max_abs(again - plain), 1e-9 * max_abs(plain));
+}
+
 TEST(MessNewton, HessianProductMatchesDifferencesOfTheObjectiveGradient) {
   for (const bool with_group : {false, true}) {
     mess::MessSystem sys = pair_in_field();

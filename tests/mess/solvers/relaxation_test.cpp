@@ -236,6 +236,11 @@ TEST(MessSolvers, SeedProfileRelaxesWithBothMethods) {
   const mess::MinimiserResult rb = mess::minimise(b, opt);
   ASSERT_TRUE(ra.converged) << mess::to_string(ra.status);
   ASSERT_TRUE(rb.converged) << mess::to_string(rb.status);
+  // L-BFGS met the seed's own forces after its conservative phase (the correction passes),
+  // without FIRE.
+  EXPECT_TRUE(ra.forces_only_phase);
+  EXPECT_FALSE(ra.finished_with_fire);
+  EXPECT_LE(ra.max_force, 1e-8 * ra.force_scale);
   EXPECT_LT((a.particle_centres() - b.particle_centres()).cwiseAbs().maxCoeff() / a.length_scale(),
             1e-5);
   EXPECT_LT(separation(a), 6.0 - 0.05);

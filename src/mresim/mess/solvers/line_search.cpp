@@ -9,7 +9,13 @@ namespace mresim::mess::detail {
 bool StallGuard::stalled(const Eigen::VectorXd& g, double change, const Objective& f,
                          bool use_energy) {
   const double gmax = g.cwiseAbs().maxCoeff();
-  const double noise = 64.0 * std::numeric_limits<double>::epsilon() * f.magnitude();
+  // An energy decrease counts as progress down to eps times the potential's rounding scale:
+  // the bound on the rounding of a sum, which its typical rounding stays well below. With
+  // 64 eps (the line search's slack), a full-size pair in contact (Fig. 4.11 at 40 mT,
+  // magnitude 4.4e4 E0) was declared stalled at 6e-5 F0 while its energy still fell by
+  // 1e-10 E0 per iteration, every time, and FIRE had to finish the step; with eps it
+  // converges (docs/performance.md, "Routes measured for L-BFGS").
+  const double noise = std::numeric_limits<double>::epsilon() * f.magnitude();
   if (gmax < best_gradient_ || (use_energy && change < -noise)) {
     best_gradient_ = std::min(best_gradient_, gmax);
     count_ = 0;

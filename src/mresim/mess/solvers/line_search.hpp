@@ -19,7 +19,7 @@ struct InnerResult {
 
 // Ends an inner minimisation that no longer makes progress: `limit` iterations in a row
 // without a new smallest gradient component and (when energies are used) without an energy
-// decrease beyond the potential's rounding noise (64 eps times its magnitude).
+// decrease beyond the potential's rounding noise (eps times its magnitude).
 class StallGuard {
  public:
   StallGuard(const Eigen::VectorXd& g, int limit)

@@ -55,8 +55,25 @@ double Objective::operator()(const Eigen::VectorXd& u, Eigen::VectorXd& gradient
   last_ = distributed_ != nullptr ? distributed_->evaluate(system_, &gradient_)
                                   : system_.evaluate(&gradient_);
   ++evaluations_;
+  if (load_.size() == 0) {
+    gradient = map_.reduce(gradient_) / e0_;
+    return last_.potential / e0_;
+  }
+  gradient_ += load_;
   gradient = map_.reduce(gradient_) / e0_;
-  return last_.potential / e0_;
+  return last_.potential / e0_ + load_reduced_.dot(u - load_origin_);
+}
+
+void Objective::set_load(const Eigen::Matrix3Xd& load, const Eigen::VectorXd& u_ref) {
+  load_ = load;
+  load_reduced_ = map_.reduce(load) / e0_;
+  load_origin_ = u_ref;
+}
+
+void Objective::clear_load() {
+  load_.resize(3, 0);
+  load_reduced_.resize(0);
+  load_origin_.resize(0);
 }
 
 }  // namespace mresim::mess::detail

@@ -46,6 +46,13 @@ class Objective {
 
   double operator()(const Eigen::VectorXd& u, Eigen::VectorXd& gradient);
 
+  // A constant load added to the potential until clear_load(): gradient += `load` (3 x N,
+  // J/m, the layout of full_gradient()) and potential += load . (x - x(u_ref)). The
+  // minimiser's correction passes for the seed's forces use it (minimiser.cpp).
+  // full_gradient() includes the load.
+  void set_load(const Eigen::Matrix3Xd& load, const Eigen::VectorXd& u_ref);
+  void clear_load();
+
   double energy_scale() const { return e0_; }
   MessSystem& system() { return system_; }
   // The potential's rounding scale (sum of |terms|) of the last evaluation, scaled.
@@ -62,6 +69,9 @@ class Objective {
   Evaluation last_;
   Eigen::Matrix3Xd gradient_;
   std::int64_t evaluations_ = 0;
+  Eigen::Matrix3Xd load_;         // empty without a load
+  Eigen::VectorXd load_reduced_;  // the load on the free variables, scaled
+  Eigen::VectorXd load_origin_;   // u_ref
 };
 
 }  // namespace mresim::mess::detail
