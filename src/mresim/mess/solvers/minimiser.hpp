@@ -28,8 +28,10 @@
 // potential's gradient (they differ by the particles' internal deformation), which L-BFGS's
 // line search cannot live with. L-BFGS therefore relaxes the conservative neighbour (centre =
 // mean of all nodes) first; then the seed's own forces are evaluated and, if above the
-// tolerance, L-BFGS continues on them with a slope-only line search (no energy tests:
-// forces_only_phase), and FIRE finishes should that fail too. The result always meets the
+// tolerance (forces_only_phase), L-BFGS continues in correction passes: the neighbour's
+// potential plus the seed's force difference frozen as a constant load, re-frozen after each
+// pass. Should a pass fail, L-BFGS goes on with a slope-only line search on the seed's forces
+// (no energy tests), and FIRE finishes should that fail too. The result always meets the
 // tolerance on the profile's own forces.
 //
 // Fallbacks, reported in MinimiserResult: when the L-BFGS line search fails or stalls, with
@@ -145,7 +147,7 @@ struct MinimiserResult {
   int iterations = 0;        // inner iterations (L-BFGS steps or FIRE steps)
   int outer_iterations = 0;  // magnetization re-solves between minimisations (alternating)
   bool switched_to_alternating = false;   // every_evaluation fell back to alternating
-  bool forces_only_phase = false;         // seed: L-BFGS continued on the seed's own forces
+  bool forces_only_phase = false;         // seed: relaxed further to the seed's own forces
   bool finished_with_fire = false;        // lbfgs's line search failed; FIRE finished
   bool finished_with_lbfgs = false;       // newton's line search failed; L-BFGS went on
   std::int64_t evaluations = 0;           // energy + gradient evaluations
