@@ -373,7 +373,7 @@ class Minimisation {
   // L-BFGS needs forces that are the potential's gradient. The seed's centre-voxel spreading is
   // not quite (it differs by the particles' internal deformation), so L-BFGS first relaxes the
   // conservative neighbour (centre = mean of all nodes, exact gradient); the seed's own forces
-  // are then checked, and FIRE (forces only) finishes if they exceed the tolerance.
+  // are then checked and, if they exceed the tolerance, relaxed (end_conservative_phase).
   MinimiserResult run() {
     conservative_phase_ =
         method_ != MinimiserMethod::fire && caller_centre_rule() == CentreRule::centre_voxel;
@@ -516,7 +516,8 @@ class Minimisation {
   }
 
   // Back to the caller's centre rule (the seed's centre voxel); false if its forces are below
-  // the tolerance too, else L-BFGS continues on them with a slope-only line search.
+  // the tolerance too, else L-BFGS continues on them: in correction passes after a converged
+  // conservative phase, with the slope-only line search otherwise (and Newton on its own).
   bool end_conservative_phase(MinimiserStatus status) {
     conservative_phase_ = false;
     rules_.set_centre_rule(caller_centre_rule());
