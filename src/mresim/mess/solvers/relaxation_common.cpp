@@ -55,13 +55,10 @@ double Objective::operator()(const Eigen::VectorXd& u, Eigen::VectorXd& gradient
   last_ = distributed_ != nullptr ? distributed_->evaluate(system_, &gradient_)
                                   : system_.evaluate(&gradient_);
   ++evaluations_;
-  if (load_.size() == 0) {
-    gradient = map_.reduce(gradient_) / e0_;
-    return last_.potential / e0_;
-  }
-  gradient_ += load_;
+  const bool loaded = load_.size() != 0;
+  if (loaded) gradient_ += load_;
   gradient = map_.reduce(gradient_) / e0_;
-  return last_.potential / e0_ + load_reduced_.dot(u - load_origin_);
+  return last_.potential / e0_ + (loaded ? load_reduced_.dot(u - load_origin_) : 0.0);
 }
 
 void Objective::set_load(const Eigen::Matrix3Xd& load, const Eigen::VectorXd& u_ref) {
