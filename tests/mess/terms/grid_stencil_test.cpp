@@ -2,7 +2,8 @@
 // cells in increasing index, the order of explicit node -> spring/cell lists, on boxes from one
 // cell (where two spring offsets share an index step) up; the spring kernel's gradient and
 // Hessian product are bitwise those of a gather over such lists, also on a box big enough for
-// the parallel loop; and the spring stencil refuses a spring set numbered otherwise.
+// the parallel loop and with more threads than energy blocks, and its energy with a gradient is
+// bitwise the energy-only sum; and the spring stencil refuses a spring set numbered otherwise.
 
 #include "mresim/mess/terms/grid_stencil.hpp"
 
@@ -62,7 +63,11 @@ void expect_kernel_matches_reference(const lat::Lattice& l) {
   const mess::SpringKernel kernel(l);
 
   Eigen::Matrix3Xd gradient = start;
-  kernel.evaluate(l, x, &gradient);
+  const mess::ElasticValue with_gradient = kernel.evaluate(l, x, &gradient);
+  // The fused sweep sums the energy in the blocks of the energy-only evaluation.
+  const mess::ElasticValue energy_only = kernel.evaluate(l, x, nullptr);
+  EXPECT_EQ(with_gradient.energy, energy_only.energy);
+  EXPECT_EQ(with_gradient.rounding, energy_only.rounding);
   Eigen::Matrix3Xd expected = start;
   reference_gather(l, expected, [&](std::size_t s) {
     const Eigen::Vector3d r = x.col(sp.second[s]) - x.col(sp.first[s]);
@@ -157,6 +162,22 @@ TEST(SpringStencil, GatherMatchesTheReferenceOnEveryThreadCount) {
   ASSERT_GT(l.node_count(), mess::detail::kParallelMinimum / 4);
   const int saved = omp_get_max_threads();
   for (const int threads : {1, 2, 3}) {
+    SCOPED_TRACE(threads);
+    omp_set_num_threads(threads);
+    expect_kernel_matches_reference(l);
+  }
+  omp_set_num_threads(saved);
+}
+
+TEST(SpringKernel, GradientMatchesTheReferenceWithMoreThreadsThanEnergyBlocks) {
+  // Just over detail::kParallelMinimum springs: 5 energy blocks for 8 threads, so some threads
+  // own no block and the last one the last node alone.
+  const lat::Lattice l = small_lattice(mess::model_profile("physical"), {10, 10, 12});
+  const auto springs = static_cast<std::int64_t>(l.springs.size());
+  ASSERT_GE(springs, mess::detail::kParallelMinimum);
+  ASSERT_LT((springs + mess::detail::kSumBlock - 1) / mess::detail::kSumBlock, 8);
+  const int saved = omp_get_max_threads();
+  for (const int threads : {1, 4, 8}) {
     SCOPED_TRACE(threads);
     omp_set_num_threads(threads);
     expect_kernel_matches_reference(l);

@@ -1,6 +1,9 @@
 #include "mresim/mess/terms/elastic_terms.hpp"
 
+#include <omp.h>
+
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -74,6 +77,9 @@ void add_volume_gradient(const std::vector<std::array<std::int32_t, 8>>& element
 
 namespace {
 
+// Nodes whose springs evaluate_with_gradient computes in one flat pass before gathering them.
+constexpr std::int64_t kChunkNodes = 512;
+
 // Runs body(i) for i < n, in parallel for large n; each i writes only its own scratch slot.
 template <class Body>
 void for_each_item(std::int64_t n, Body&& body) {
@@ -102,33 +108,152 @@ void check_shapes(const char* who, std::int64_t node_count, const lattice::Latti
 }  // namespace
 
 SpringKernel::SpringKernel(const lattice::Lattice& lat)
-    : node_count_(lat.node_count()), stencil_(lat) {}
+    : node_count_(lat.node_count()), stencil_(lat) {
+  // A node's backward springs come from the max_delta() nodes below it, so a ring holding the
+  // springs of that many nodes plus the node itself (13 springs each at most) never overwrites
+  // a tension that a later gather still reads. No larger than the whole set is needed.
+  const std::int64_t needed = std::min<std::int64_t>(13 * (stencil_.max_delta() + kChunkNodes + 1),
+                                                     std::max<std::int64_t>(stencil_.spring_count(), 1));
+  ring_capacity_ = 1;
+  while (ring_capacity_ < needed) ring_capacity_ *= 2;
+}
 
 ElasticValue SpringKernel::evaluate(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
                                     Eigen::Matrix3Xd* gradient) const {
   check_shapes("SpringKernel::evaluate", node_count_, lat, x);
+  if (gradient != nullptr) return evaluate_with_gradient(lat, x, *gradient);
   const lattice::SpringSet& sp = lat.springs;
-  const auto springs = static_cast<std::int64_t>(sp.size());
-  const bool want_gradient = gradient != nullptr;
-  if (want_gradient) scratch_.resize(static_cast<std::size_t>(springs));
   // Rest lengths by kind, the values sp.rest_length(s) gives, looked up without a call.
   const std::array<double, 3> rest_length = elastic::rest_lengths(sp.element_length);
-  // Energy (eq. 4.62) and tension k (l - L)/l (eq. 4.63).
-  const auto sums = detail::fixed_order_sums(springs, [&](std::int64_t s) {
-    const auto u = static_cast<std::size_t>(s);
-    const double l = (x.col(sp.second[u]) - x.col(sp.first[u])).norm();
-    const elastic::SpringValue value = elastic::spring_value(
-        sp.stiffness[u], rest_length[static_cast<std::size_t>(sp.kind[u])], l);
-    if (want_gradient) scratch_[u] = value.tension;
-    return std::array<double, 2>{value.energy, value.rounding};
-  });
-  if (gradient == nullptr) return {sums[0], sums[1]};
-  // Gather: every node sums its own springs in a fixed order (no races, no atomics).
-  stencil_.gather(*gradient, [&](std::int64_t s, std::int64_t first, std::int64_t second) {
-    const Eigen::Vector3d r = x.col(second) - x.col(first);
-    return Eigen::Vector3d(scratch_[static_cast<std::size_t>(s)] * r);
-  });
+  // Energy (eq. 4.62) and its rounding scale.
+  const auto sums =
+      detail::fixed_order_sums(static_cast<std::int64_t>(sp.size()), [&](std::int64_t s) {
+        const auto u = static_cast<std::size_t>(s);
+        const double l = (x.col(sp.second[u]) - x.col(sp.first[u])).norm();
+        const elastic::SpringValue value = elastic::spring_value(
+            sp.stiffness[u], rest_length[static_cast<std::size_t>(sp.kind[u])], l);
+        return std::array<double, 2>{value.energy, value.rounding};
+      });
   return {sums[0], sums[1]};
+}
+
+// Every spring's tension k (l - L)/l (eq. 4.63) is computed once and gathered by both its ends
+// in the stencil's order, as SpringStencil::gather would, and the energy is summed in the
+// blocks of detail::fixed_order_sums, so the results are bitwise those of a tension pass, a
+// scratch array and a gather, for any thread count. Instead of an array of all tensions
+// (8 bytes per spring, written and read back), each thread keeps a ring of the last
+// ring_capacity_ tensions: it takes a contiguous run of the energy blocks and sweeps their
+// nodes in index order. Each node first gathers its backward springs from the ring (they come
+// from the max_delta() nodes below it, computed earlier), then computes its forward springs
+// (from their ends on the grid, no index arrays), subtracts them at once and leaves their
+// tensions in the ring. A thread first computes the springs of the max_delta() nodes before
+// its own (those tensions are the previous thread's to sum), and the forward springs of its
+// last node may reach into the next thread's blocks; the energy counts only its own blocks.
+ElasticValue SpringKernel::evaluate_with_gradient(const lattice::Lattice& lat,
+                                                  const Eigen::Matrix3Xd& x,
+                                                  Eigen::Matrix3Xd& gradient) const {
+  const lattice::SpringSet& sp = lat.springs;
+  const std::int64_t springs = stencil_.spring_count();
+  const std::int64_t nodes = stencil_.node_count();
+  const std::int64_t blocks = (springs + detail::kSumBlock - 1) / detail::kSumBlock;
+  std::vector<std::array<double, 2>> partial(static_cast<std::size_t>(blocks), {0.0, 0.0});
+  const std::array<double, 3> rest_length = elastic::rest_lengths(sp.element_length);
+  const bool parallel = springs >= detail::kParallelMinimum;
+  const int max_threads = parallel ? omp_get_max_threads() : 1;
+  rings_.resize(static_cast<std::size_t>(max_threads * ring_capacity_));
+  const int nz = lat.shape.nz();
+  const int nx = lat.shape.nx();
+  const std::int64_t behind = stencil_.max_delta();
+  const auto mask = static_cast<std::uint64_t>(ring_capacity_ - 1);
+
+#pragma omp parallel if (parallel)
+  {
+    const auto threads = static_cast<std::int64_t>(omp_get_num_threads());
+    const auto thread = static_cast<std::int64_t>(omp_get_thread_num());
+    // This thread's energy blocks, their springs [own_begin, own_end), and the nodes whose
+    // first spring lies there (the last thread also takes the last node, which has none).
+    const std::int64_t own_begin = std::min(springs, blocks * thread / threads * detail::kSumBlock);
+    const std::int64_t own_end =
+        std::min(springs, blocks * (thread + 1) / threads * detail::kSumBlock);
+    const auto first_node_from = [&](std::int64_t spring) {
+      std::int64_t lo = 0;
+      std::int64_t hi = nodes;
+      while (lo < hi) {  // the first node whose first spring is >= spring
+        const std::int64_t mid = lo + (hi - lo) / 2;
+        if (stencil_.first_spring(mid) < spring) {
+          lo = mid + 1;
+        } else {
+          hi = mid;
+        }
+      }
+      return lo;
+    };
+    const std::int64_t node_begin = first_node_from(own_begin);
+    const std::int64_t node_end = thread + 1 == threads ? nodes : first_node_from(own_end);
+    double* ring = rings_.data() + thread * ring_capacity_;
+
+    std::int64_t block = -1;
+    std::array<double, 2> block_sum{0.0, 0.0};
+    const auto flush = [&] {
+      if (block >= 0) partial[static_cast<std::size_t>(block)] = block_sum;
+      block_sum = {0.0, 0.0};
+    };
+    // Tensions of the springs of the nodes [next, end), in one flat pass as a whole-array
+    // pass would do it, into the ring; the energy of those that are this thread's.
+    std::int64_t next = std::max<std::int64_t>(0, node_begin - behind);
+    const auto compute_through = [&](std::int64_t end) {
+      const std::int64_t stop = stencil_.first_spring(end);
+      for (std::int64_t s = stencil_.first_spring(next); s < stop; ++s) {
+        const auto u = static_cast<std::size_t>(s);
+        const double l = (x.col(sp.second[u]) - x.col(sp.first[u])).norm();
+        const elastic::SpringValue value = elastic::spring_value(
+            sp.stiffness[u], rest_length[static_cast<std::size_t>(sp.kind[u])], l);
+        ring[static_cast<std::uint64_t>(s) & mask] = value.tension;
+        if (s < own_begin || s >= own_end) continue;
+        if (s / detail::kSumBlock != block) {
+          flush();
+          block = s / detail::kSumBlock;
+        }
+        block_sum[0] += value.energy;
+        block_sum[1] += value.rounding;
+      }
+      next = end;
+    };
+    compute_through(node_begin);  // the backward springs of this thread's first nodes
+    // Grid coordinates of node n = iz + nz (ix + nx iy), advanced with n.
+    int iz = static_cast<int>(node_begin % nz);
+    int ix = static_cast<int>((node_begin / nz) % nx);
+    int iy = static_cast<int>(node_begin / nz / nx);
+    for (std::int64_t chunk = node_begin; chunk < node_end; chunk += kChunkNodes) {
+      const std::int64_t chunk_end = std::min(chunk + kChunkNodes, node_end);
+      compute_through(chunk_end);
+      for (std::int64_t n = chunk; n < chunk_end; ++n) {
+        const auto contribution = [&](std::int64_t s, std::int64_t first, std::int64_t second) {
+          const Eigen::Vector3d r = x.col(second) - x.col(first);
+          return Eigen::Vector3d(ring[static_cast<std::uint64_t>(s) & mask] * r);
+        };
+        Eigen::Vector3d g = stencil_.gather_backward(n, ix, iy, iz, gradient.col(n), contribution);
+        stencil_.for_each_forward_spring(n, [&](std::int64_t s, int, std::int64_t second) {
+          g -= contribution(s, n, second);
+        });
+        gradient.col(n) = g;
+        if (++iz == nz) {
+          iz = 0;
+          if (++ix == nx) {
+            ix = 0;
+            ++iy;
+          }
+        }
+      }
+    }
+    flush();
+  }
+  std::array<double, 2> total{0.0, 0.0};
+  for (const auto& s : partial) {
+    total[0] += s[0];
+    total[1] += s[1];
+  }
+  return {total[0], total[1]};
 }
 
 void SpringKernel::add_hessian_product(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,

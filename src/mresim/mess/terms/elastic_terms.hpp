@@ -70,9 +70,11 @@ struct ElasticEnergies {
 
 // The two elastic kernels, parallelised with OpenMP so that every result is bitwise
 // independent of the thread count: every spring's tension and every cell's volume derivative
-// is computed once into scratch arrays, then every node gathers its own contributions in a
-// fixed order (increasing spring or cell index, found by the grid stencils of
-// grid_stencil.hpp). Energies are summed in
+// is computed once, then every node gathers its own contributions in a fixed order (increasing
+// spring or cell index, found by the grid stencils of grid_stencil.hpp). The cells' derivatives
+// go to a scratch array; the springs' tensions to a small ring per thread, each thread
+// sweeping its share of the springs in index order and gathering every node as soon as its
+// springs are done (SpringKernel::evaluate). Energies are summed in
 // fixed blocks (fixed_order.hpp). Gradients and Hessian products are ADDED per node in the order g
 // = out.col(n); g += contributions; out.col(n) = g, so a springs pass followed by a volume pass
 // gives the same bits as one fused pass. Not safe for concurrent calls on one object (the scratch
@@ -105,10 +107,17 @@ class SpringKernel {
                                   std::vector<Eigen::Triplet<double>>& entries);
 
  private:
+  // evaluate with a gradient: the fused tension sweep and gather.
+  ElasticValue evaluate_with_gradient(const lattice::Lattice& lattice, const Eigen::Matrix3Xd& x,
+                                      Eigen::Matrix3Xd& gradient) const;
+
   std::int64_t node_count_ = 0;
   SpringStencil stencil_;  // node -> incident springs, from the grid
-  // Scratch: tension k (l - L)/l per spring, or B (v_j - v_i) (3 per spring).
+  // Scratch of the Hessian product: B (v_j - v_i) per spring (3 doubles).
   mutable std::vector<double> scratch_;
+  // The tension rings of evaluate_with_gradient, ring_capacity_ doubles per thread.
+  mutable std::vector<double> rings_;
+  std::int64_t ring_capacity_ = 0;  // a power of two
 };
 
 // Volume elements, eq. 4.64 x V0, times force_factor in gradients and Hessians. Exact Hessian

@@ -63,6 +63,7 @@ SpringStencil::SpringStencil(const lattice::Lattice& lattice) : shape_(lattice.s
     }
     mask_[static_cast<std::size_t>(n)] = static_cast<std::uint16_t>(mask);
   }
+  spring_count_ = static_cast<std::int64_t>(s);
   if (s != springs.size()) {
     throw std::invalid_argument("SpringStencil: the lattice has " + std::to_string(springs.size()) +
                                 " springs, its grid " + std::to_string(s));

@@ -25,6 +25,7 @@
 // running 1, 0; the node is the cell's vertex with vertex_offset (dx, dy, dz). No data.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -58,12 +59,39 @@ class SpringStencil {
   explicit SpringStencil(const lattice::Lattice& lattice);
 
   std::int64_t node_count() const { return static_cast<std::int64_t>(mask_.size()); }
+  std::int64_t spring_count() const { return spring_count_; }
+  // The springs of the nodes below `node` (node_count() gives spring_count()).
+  std::int64_t first_spring(std::int64_t node) const {
+    return node < node_count() ? first_spring_[static_cast<std::size_t>(node)] : spring_count_;
+  }
+  // The largest node index step of a spring (the offset (+x, +y, +z)): a node's backward
+  // springs all come from the nodes at most this far below it.
+  std::int64_t max_delta() const { return *std::max_element(delta_.begin(), delta_.end()); }
 
   // For every node n: g = out.col(n); then, for each spring s incident to n in increasing s,
   // g += contribution(s, first, second) if n is the spring's second end, g -= ... if it is the
   // first; out.col(n) = g. `contribution` returns an Eigen::Vector3d.
   template <class Contribution>
   void gather(Eigen::Matrix3Xd& out, Contribution&& contribution) const;
+
+  // The first part of gather's sum for one node, at grid coordinates (ix, iy, iz): g plus the
+  // contributions of its backward springs (those with `node` as second end), in increasing
+  // spring index. Its forward springs come after them (for_each_forward_spring).
+  template <class Contribution>
+  Eigen::Vector3d gather_backward(std::int64_t node, int ix, int iy, int iz, Eigen::Vector3d g,
+                                  Contribution&& contribution) const;
+
+  // visit(s, offset, second) for the forward springs of `node` (those with `node` as first
+  // end), in increasing s: the order in which build_springs numbers them.
+  template <class Visit>
+  void for_each_forward_spring(std::int64_t node, Visit&& visit) const {
+    const unsigned mask = mask_[static_cast<std::size_t>(node)];
+    std::int64_t s = first_spring_[static_cast<std::size_t>(node)];
+    for (int o = 0; o < 13; ++o) {
+      if (((mask >> static_cast<unsigned>(o)) & 1U) == 0) continue;
+      visit(s++, o, node + delta_[static_cast<std::size_t>(o)]);
+    }
+  }
 
  private:
   // first_spring[node] + the number of the node's present offsets below `offset` (a table
@@ -80,6 +108,7 @@ class SpringStencil {
   std::vector<std::int64_t> first_spring_;  // per node
   std::vector<std::uint16_t> mask_;         // per node: bit o = offset o stays in the box
   std::vector<std::uint8_t> bits_set_;      // number of bits set, for every 13-bit mask
+  std::int64_t spring_count_ = 0;
 };
 
 template <class Contribution>
@@ -94,29 +123,36 @@ void SpringStencil::gather(Eigen::Matrix3Xd& out, Contribution&& contribution) c
     const int iy = static_cast<int>(row / nx);
     for (int iz = 0; iz < nz; ++iz) {
       const std::int64_t n = iz + nz * row;
-      Eigen::Vector3d g = out.col(n);
-      // Away from the box's faces every backward neighbour exists (the usual case).
-      const bool inside = ix > 0 && ix < nx - 1 && iy > 0 && iy < ny - 1 && iz > 0 && iz < nz - 1;
-      for (const int o : backward_order_) {
-        if (!inside) {
-          const auto& d = lattice::kForwardNeighbours[static_cast<std::size_t>(o)];
-          const int mx = ix - d[0];
-          const int my = iy - d[1];
-          const int mz = iz - d[2];
-          if (mx < 0 || mx >= nx || my < 0 || my >= ny || mz < 0 || mz >= nz) continue;
-        }
-        const std::int64_t m = n - delta_[static_cast<std::size_t>(o)];
-        g += contribution(spring_of(m, o), m, n);
-      }
-      const unsigned mask = mask_[static_cast<std::size_t>(n)];
-      std::int64_t s = first_spring_[static_cast<std::size_t>(n)];
-      for (int o = 0; o < 13; ++o) {
-        if (((mask >> static_cast<unsigned>(o)) & 1U) == 0) continue;
-        g -= contribution(s++, n, n + delta_[static_cast<std::size_t>(o)]);
-      }
+      Eigen::Vector3d g = gather_backward(n, ix, iy, iz, out.col(n), contribution);
+      for_each_forward_spring(n, [&](std::int64_t s, int, std::int64_t second) {
+        g -= contribution(s, n, second);
+      });
       out.col(n) = g;
     }
   }
+}
+
+template <class Contribution>
+Eigen::Vector3d SpringStencil::gather_backward(std::int64_t n, int ix, int iy, int iz,
+                                               Eigen::Vector3d g,
+                                               Contribution&& contribution) const {
+  const int nx = shape_.nx();
+  const int ny = shape_.ny();
+  const int nz = shape_.nz();
+  // Away from the box's faces every backward neighbour exists (the usual case).
+  const bool inside = ix > 0 && ix < nx - 1 && iy > 0 && iy < ny - 1 && iz > 0 && iz < nz - 1;
+  for (const int o : backward_order_) {
+    if (!inside) {
+      const auto& d = lattice::kForwardNeighbours[static_cast<std::size_t>(o)];
+      const int mx = ix - d[0];
+      const int my = iy - d[1];
+      const int mz = iz - d[2];
+      if (mx < 0 || mx >= nx || my < 0 || my >= ny || mz < 0 || mz >= nz) continue;
+    }
+    const std::int64_t m = n - delta_[static_cast<std::size_t>(o)];
+    g += contribution(spring_of(m, o), m, n);
+  }
+  return g;
 }
 
 class CellStencil {
