@@ -276,5 +276,36 @@ TEST(LatticeSprings, ParticleRulesDifferOnlyBetweenNeighbouringParticles) {
   EXPECT_EQ(seed_particle, phys_particle + cross);
 }
 
+// The one-byte stiffness table gives back every pushed value bit for bit, shares equal values,
+// and refuses a 257th distinct value; a lattice with a particle needs at most 15 values.
+TEST(LatticeSprings, StiffnessTableKeepsEveryValueExactly) {
+  SpringStiffness table;
+  std::vector<double> pushed;
+  for (int i = 0; i < 256; ++i) {
+    const double k = std::nextafter(1.0 + i / 7.0, 2.0);  // not exactly representable sums
+    table.push_back(k);
+    table.push_back(k);
+    pushed.push_back(k);
+    pushed.push_back(k);
+  }
+  ASSERT_EQ(table.size(), pushed.size());
+  for (std::size_t s = 0; s < pushed.size(); ++s) EXPECT_EQ(table[s], pushed[s]) << s;
+  EXPECT_EQ(table.distinct_values().size(), 256u);
+  EXPECT_THROW(table.push_back(3.5), std::length_error);
+  table.push_back(pushed[5]);  // a known value still fits
+  EXPECT_EQ(table[table.size() - 1], pushed[5]);
+
+  LatticeSpec spec;
+  spec.placement = ByHandPlacement{{Eigen::Vector3d(5e-6, 5e-6, 5e-6)},
+                                   {Eigen::Vector3d(2.5e-6, 2.5e-6, 2.5e-6)}};
+  const Lattice lat = build_lattice(spec);
+  const std::vector<double>& distinct = lat.springs.stiffness.distinct_values();
+  EXPECT_LE(distinct.size(), 15u);
+  std::set<double> seen;
+  for (std::size_t i = 0; i < lat.springs.size(); ++i) seen.insert(lat.springs.stiffness[i]);
+  EXPECT_EQ(seen, std::set<double>(distinct.begin(), distinct.end()));
+  EXPECT_EQ(seen.size(), distinct.size());  // each value once in the table
+}
+
 }  // namespace
 }  // namespace mresim::lattice

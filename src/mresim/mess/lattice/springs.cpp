@@ -61,6 +61,18 @@ int bulk_cells_containing(SpringKind kind) {
   return 1;
 }
 
+void SpringStiffness::push_back(double k) {
+  std::size_t v = 0;
+  while (v < values_.size() && values_[v] != k) ++v;
+  if (v == values_.size()) {
+    if (values_.size() == 256) {
+      throw std::length_error("SpringStiffness: more than 256 distinct spring stiffnesses");
+    }
+    values_.push_back(k);
+  }
+  index_.push_back(static_cast<std::uint8_t>(v));
+}
+
 SpringSet build_springs(const GridShape& shape, double element_length,
                         const SpringConstants& polymer, const SpringConstants& particle,
                         const std::vector<std::int32_t>& particle_of_node,

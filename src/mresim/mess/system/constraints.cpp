@@ -1,5 +1,6 @@
 #include "mresim/mess/system/constraints.hpp"
 
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -93,21 +94,28 @@ DofMap::DofMap(const BoundaryConstraints& constraints, const Eigen::Matrix3Xd& r
     group_nodes_.push_back(g.nodes);
     group_reference_.push_back(std::move(ref));
   }
+  if (3 * n_nodes > std::numeric_limits<std::int32_t>::max()) {
+    throw std::invalid_argument("DofMap: " + std::to_string(n_nodes) +
+                                " nodes have more coordinates than 32-bit indices reach (at most " +
+                                std::to_string(std::numeric_limits<std::int32_t>::max() / 3) +
+                                " nodes)");
+  }
   dof_index_.assign(static_cast<std::size_t>(3 * n_nodes), -1);
   for (std::int64_t n = 0; n < n_nodes; ++n) {
     if (in_group[static_cast<std::size_t>(n)] != 0) continue;
     for (int a = 0; a < 3; ++a) {
       if (constraints.is_fixed(n, a)) continue;
       dof_index_[static_cast<std::size_t>(3 * n + a)] =
-          static_cast<Eigen::Index>(coordinates_.size());
-      coordinates_.push_back(3 * n + a);
+          static_cast<std::int32_t>(coordinates_.size());
+      coordinates_.push_back(static_cast<std::int32_t>(3 * n + a));
     }
   }
   const auto nc = static_cast<Eigen::Index>(coordinates_.size());
   for (std::size_t g = 0; g < group_nodes_.size(); ++g) {
     for (const std::int32_t n : group_nodes_[g]) {
       for (int a = 0; a < 3; ++a) {
-        dof_index_[3 * static_cast<std::size_t>(n) + a] = nc + 3 * static_cast<Eigen::Index>(g) + a;
+        dof_index_[3 * static_cast<std::size_t>(n) + a] =
+            static_cast<std::int32_t>(nc + 3 * static_cast<Eigen::Index>(g) + a);
       }
     }
   }
@@ -171,7 +179,7 @@ Eigen::Matrix3Xd DofMap::expand(const Eigen::VectorXd& v) const {
 
 std::vector<std::uint8_t> DofMap::own_dof_mask() const {
   std::vector<std::uint8_t> mask(dof_index_.size(), 0);
-  for (const std::int64_t c : coordinates_) mask[static_cast<std::size_t>(c)] = 1;
+  for (const std::int32_t c : coordinates_) mask[static_cast<std::size_t>(c)] = 1;
   return mask;
 }
 

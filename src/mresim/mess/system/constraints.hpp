@@ -102,10 +102,11 @@ class DofMap {
 
  private:
   double length_scale_ = 1.0;
-  std::vector<std::int64_t> coordinates_;  // flat index 3 n + a of each free coordinate
+  // 32-bit indices (the constructor checks that 3 N fits): 24 bytes per node less than 64-bit.
+  std::vector<std::int32_t> coordinates_;  // flat index 3 n + a of each free coordinate
   std::vector<std::vector<std::int32_t>> group_nodes_;
   std::vector<Eigen::Matrix3Xd> group_reference_;  // positions of each group's nodes
-  std::vector<Eigen::Index> dof_index_;            // per flat coordinate 3 n + a
+  std::vector<std::int32_t> dof_index_;            // per flat coordinate 3 n + a, -1 if held
 };
 
 }  // namespace mresim::mess
