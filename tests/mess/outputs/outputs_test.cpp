@@ -39,6 +39,9 @@ TEST(MessOutputs, ResultsSummaryAndXdmfAreConsistent) {
   EXPECT_EQ(h5.shape("/steps/centres"), (std::vector<hsize_t>{steps, 2, 3}));
   EXPECT_EQ(h5.shape("/steps/cluster_id"), (std::vector<hsize_t>{steps, 2}));
   EXPECT_EQ(h5.strings("/steps/solver/status").size(), steps);
+  // Physical profile, L-BFGS without a fallback: L-BFGS finished every step, no seed passes.
+  EXPECT_EQ(h5.strings("/steps/solver/finished_by"), std::vector<std::string>(steps, "lbfgs"));
+  EXPECT_EQ(h5.ints("/steps/solver/correction_passes"), std::vector<std::int64_t>(steps, 0));
   // The measured peak memory of the run, absolute and per node: the
   // process held at least its lattice (positions alone are 24 bytes per node).
   const auto peak = static_cast<double>(

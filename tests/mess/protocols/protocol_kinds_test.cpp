@@ -145,6 +145,27 @@ TEST(MessProtocolKinds, LeapfrogRunMatchesTheMinimiser) {
   EXPECT_NEAR(sb, sa, 1e-3 * (7e-6 - sa));
   EXPECT_NEAR(b.energies.total(), a.energies.total(), 1e-3 * std::abs(a.energies.total()));
   EXPECT_EQ(b.status, "converged");
+  // What finished each step is recorded: the seed's forces took correction passes in L-BFGS.
+  EXPECT_EQ(b.finished_by, "leapfrog");
+  EXPECT_EQ(a.finished_by, "lbfgs");
+  EXPECT_GE(a.correction_passes, 1);
+  EXPECT_EQ(b.correction_passes, 0);
+}
+
+// The name of what finished a step follows the fallbacks: FIRE over the slope-only search over
+// the configured method.
+TEST(MessProtocolKinds, FinishedByNamesTheLastMethodThatRan) {
+  mess::MinimiserResult r;
+  EXPECT_EQ(finished_by_name(r, false), "lbfgs");
+  EXPECT_EQ(finished_by_name(r, true), "newton");
+  r.finished_with_lbfgs = true;  // Newton's line search failed
+  EXPECT_EQ(finished_by_name(r, true), "lbfgs");
+  r.slope_only_fallback = true;
+  EXPECT_EQ(finished_by_name(r, true), "lbfgs_slope_only");
+  EXPECT_EQ(finished_by_name(r, false), "lbfgs_slope_only");
+  r.finished_with_fire = true;
+  EXPECT_EQ(finished_by_name(r, false), "fire");
+  EXPECT_EQ(finished_by_name(r, true), "fire");
 }
 
 // solver.method = "newton" follows the same states along a loop as the default L-BFGS, with
@@ -163,6 +184,8 @@ TEST(MessProtocolKinds, NewtonRunFollowsTheLbfgsLoop) {
     EXPECT_NEAR(b.energies.total(), a.energies.total(), 1e-6 * std::abs(a.energies.total()) + 1e-22)
         << k;
     EXPECT_EQ(a.krylov_iterations, 0) << k;  // L-BFGS does no CG
+    EXPECT_EQ(a.finished_by, "lbfgs") << k;
+    EXPECT_EQ(b.finished_by, "newton") << k;
     if (k > 0) {
       EXPECT_LT(b.iterations, a.iterations) << k;  // Newton steps against L-BFGS steps
       // Newton's directions come from CG (recorded per step).

@@ -63,6 +63,9 @@ void expect_identical_steps(const fs::path& a_dir, const fs::path& b_dir) {
     EXPECT_EQ(a.doubles(path), b.doubles(path)) << path;
   }
   EXPECT_EQ(a.ints("/steps/solver/iterations"), b.ints("/steps/solver/iterations"));
+  // Read back from the checkpoint for the steps before the resume, like the numbers above.
+  EXPECT_EQ(a.strings("/steps/solver/finished_by"), b.strings("/steps/solver/finished_by"));
+  EXPECT_EQ(a.ints("/steps/solver/correction_passes"), b.ints("/steps/solver/correction_passes"));
 }
 
 int exit_status_of(pid_t pid) { return mresim::testing::wait_child(pid); }

@@ -113,6 +113,11 @@ void write_step_records(io::Hdf5File& file, const std::string& group,
                         int_column(records, [](auto& r) { return r.evaluations; }));
   file.write_int_vector(s + "krylov_iterations",
                         int_column(records, [](auto& r) { return r.krylov_iterations; }));
+  std::vector<std::string> finished_by;
+  for (const StepRecord& r : records) finished_by.push_back(r.finished_by);
+  file.write_string_vector(s + "finished_by", finished_by);
+  file.write_int_vector(s + "correction_passes",
+                        int_column(records, [](auto& r) { return r.correction_passes; }));
   file.write_vector(s + "max_force", column(records, [](auto& r) { return r.max_force; }), "N");
   file.write_int_vector(s + "magnetization_solves",
                         int_column(records, [](auto& r) { return r.magnetization_solves; }));
@@ -176,6 +181,13 @@ std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std:
   const std::vector<std::int64_t> krylov = file.exists(s + "krylov_iterations")
                                                ? ints(s + "krylov_iterations")
                                                : std::vector<std::int64_t>(n, 0);
+  // Absent in files written before the finishing method was recorded: "unrecorded", 0.
+  const std::vector<std::string> finished_by = file.exists(s + "finished_by")
+                                                   ? file.strings(s + "finished_by")
+                                                   : std::vector<std::string>(n, "unrecorded");
+  const std::vector<std::int64_t> passes = file.exists(s + "correction_passes")
+                                               ? ints(s + "correction_passes")
+                                               : std::vector<std::int64_t>(n, 0);
   const std::vector<double> max_force = doubles(s + "max_force");
   const std::vector<std::int64_t> solves = ints(s + "magnetization_solves");
   const std::vector<std::int64_t> unconverged = ints(s + "unconverged_magnetization_solves");
@@ -183,7 +195,7 @@ std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std:
   const std::vector<std::int64_t> m_iterations = ints(s + "magnetization_iterations");
   const std::vector<double> m_residual = doubles(s + "magnetization_residual");
   const std::vector<double> wall = doubles(s + "wall_time");
-  if (status.size() != n || method.size() != n) {
+  if (status.size() != n || method.size() != n || finished_by.size() != n) {
     throw std::runtime_error("inconsistent solver data in " + group);
   }
   const auto np = static_cast<Eigen::Index>(particle_count);
@@ -200,6 +212,8 @@ std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std:
     r.iterations = iterations[i];
     r.evaluations = evaluations[i];
     r.krylov_iterations = krylov[i];
+    r.finished_by = finished_by[i];
+    r.correction_passes = passes[i];
     r.max_force = max_force[i];
     r.magnetization_solves = solves[i];
     r.unconverged_magnetization_solves = unconverged[i];

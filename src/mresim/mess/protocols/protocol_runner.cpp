@@ -46,6 +46,13 @@ double system_volume(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x) {
   return volume;
 }
 
+std::string finished_by_name(const mess::MinimiserResult& result, bool newton) {
+  if (result.finished_with_fire) return "fire";
+  if (result.slope_only_fallback) return "lbfgs_slope_only";
+  if (newton && !result.finished_with_lbfgs) return "newton";
+  return "lbfgs";
+}
+
 ProtocolRunner::ProtocolRunner(const mc::MessSpec& spec)
     : spec_(spec), steps_(plan_steps(spec)), system_(make_system(spec)) {}
 
@@ -113,6 +120,9 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
     record.iterations = r.iterations;
     record.evaluations = r.evaluations;
     record.krylov_iterations = r.krylov_iterations;
+    record.finished_by =
+        finished_by_name(r, spec_.solver.method == mc::SolverMethod::newton);
+    record.correction_passes = r.correction_passes;
     record.max_force = r.max_force;
     record.energies = r.final.energies;
   } else {
@@ -129,6 +139,7 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
     record.status = to_string(r.status);
     record.iterations = r.steps;
     record.evaluations = r.steps + 1;
+    record.finished_by = "leapfrog";
     record.max_force = r.history.empty() ? 0.0 : r.history.back().mean_abs_acceleration;
     record.energies = r.final.energies;
   }

@@ -34,6 +34,11 @@
 namespace mresim::mess_protocol {
 
 // What one converged (or not) step leaves for the outputs.
+// What finished a relaxation: "newton", "lbfgs", "lbfgs_slope_only" (L-BFGS on the seed's own
+// forces with the slope-only line search, after the correction passes gave up), "fire" (the
+// last fallback) or "leapfrog".
+std::string finished_by_name(const mess::MinimiserResult& result, bool newton);
+
 struct StepRecord {
   StepSpec step;
   mess::MessEnergies energies;
@@ -52,6 +57,10 @@ struct StepRecord {
   std::int64_t iterations = 0;         // minimiser iterations or leapfrog time steps
   std::int64_t evaluations = 0;        // force evaluations
   std::int64_t krylov_iterations = 0;  // newton: CG iterations (Hessian products); else 0
+  // The method that finished the step (finished_by_name): the configured one unless a fallback
+  // took over, so that a slow step can be traced to FIRE or the slope-only search.
+  std::string finished_by;
+  std::int64_t correction_passes = 0;  // seed profile, L-BFGS: correction passes for its forces
   double max_force = 0.0;  // N (minimiser); leapfrog: mean |a| of its last round, scaled
   std::int64_t magnetization_solves = 0;
   std::int64_t unconverged_magnetization_solves = 0;

@@ -391,6 +391,7 @@ class Minimisation {
       res_.status = MinimiserStatus::max_iterations;
     }
     res_.final = f_.last_evaluation();
+    res_.correction_passes = correction_passes_;
     res_.max_force = measure_.max_force(f_.full_gradient());
     res_.evaluations = f_.evaluations();
     if (newton_ != nullptr) {
@@ -529,6 +530,7 @@ class Minimisation {
       return true;
     }
     use_energy_ = false;
+    res_.slope_only_fallback = method_ == MinimiserMethod::lbfgs;
     return true;
   }
 
@@ -573,6 +575,7 @@ class Minimisation {
     rules_.set_centre_rule(caller_centre_rule());
     if (status == MinimiserStatus::max_iterations && budget_ <= 0) return false;
     use_energy_ = false;
+    res_.slope_only_fallback = true;
     return true;
   }
 

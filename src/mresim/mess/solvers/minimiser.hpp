@@ -150,6 +150,8 @@ struct MinimiserResult {
   bool forces_only_phase = false;         // seed: relaxed further to the seed's own forces
   bool finished_with_fire = false;        // lbfgs's line search failed; FIRE finished
   bool finished_with_lbfgs = false;       // newton's line search failed; L-BFGS went on
+  int correction_passes = 0;              // seed: correction passes for its forces (L-BFGS)
+  bool slope_only_fallback = false;       // seed: L-BFGS went on with the slope-only search
   std::int64_t evaluations = 0;           // energy + gradient evaluations
   std::int64_t krylov_iterations = 0;     // newton: CG iterations (Hessian products)
   double preconditioner_seconds = 0.0;    // newton: building the multigrid (0 when reused)
