@@ -111,12 +111,16 @@ TEST(Progress, StepLineHoldsIterationsResidualConvergenceAndTime) {
   progress.end_step({42, 1.5e-9, true, 2.0});
   progress.begin_step("B 0.2 T, load 0.01");
   progress.end_step({7, 2e-3, false, 0.3});
+  progress.begin_step("B 0.3 T");
+  progress.end_step({9000, 1e-15, true, 600.0, "fire"});
   EXPECT_EQ(contents(bench.stream),
             "hysteresis: step 1/3 (B 0.1 T): 42 iterations, max force 1.5e-09 N, converged yes, "
             "2.0s\n"
             "hysteresis: step 2/3 (B 0.2 T, load 0.01): 7 iterations, max force 0.002 N, "
-            "converged no, 0.3s\n");
-  EXPECT_EQ(progress.done(), 2U);
+            "converged no, 0.3s\n"
+            "hysteresis: step 3/3 (B 0.3 T): 9000 iterations, max force 1e-15 N, converged yes, "
+            "10m00s, finished by fire\n");
+  EXPECT_EQ(progress.done(), 3U);
 }
 
 // During a long step: a heartbeat each 30 s with the latest iteration, none in between.

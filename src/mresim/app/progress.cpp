@@ -128,6 +128,9 @@ void Progress::end_step(const StepResult& result) {
   line += fmt::format(": {} iterations, {}, converged {}, {}", result.iterations,
                       residual_text(result.residual), result.converged ? "yes" : "no",
                       format_duration(result.wall_seconds));
+  if (!result.finished_by_fallback.empty()) {
+    line += fmt::format(", finished by {}", result.finished_by_fallback);
+  }
   output().record(line);
   step_what_.clear();
   step_iteration_ = -1;

@@ -48,6 +48,9 @@ class Progress {
     double residual = 0.0;  // in the unit of set_residual
     bool converged = false;
     double wall_seconds = 0.0;
+    // Empty, or the fallback method that finished the step in place of the configured one
+    // (the line then ends ", finished by fire").
+    std::string finished_by_fallback;
   };
 
   // total_units = 0 means "unknown yet": the lines then show a count without percent or ETA.

@@ -88,7 +88,12 @@ class MessPlan final : public app::RunPlan {
     while (state.next_step < total) {
       progress.begin_step(step_description(runner.steps()[state.next_step]));
       const StepRecord& record = runner.run_next_step(state);
-      progress.end_step({record.iterations, record.max_force, record.converged, record.wall_time});
+      // The step line names a fallback that finished the step (it explains a slow step).
+      const std::string configured = leapfrog                                          ? "leapfrog"
+                                     : spec_.solver.method == mc::SolverMethod::newton ? "newton"
+                                                                                       : "lbfgs";
+      progress.end_step({record.iterations, record.max_force, record.converged, record.wall_time,
+                         record.finished_by == configured ? "" : record.finished_by});
       if (spec_.output.node_positions) {
         write_step_positions(staging_dir, record.step.index, runner.system().positions(),
                              runner.system().lattice().positions);
