@@ -3,7 +3,8 @@
 // cell (where two spring offsets share an index step) up; the spring kernel's gradient and
 // Hessian product are bitwise those of a gather over such lists, also on a box big enough for
 // the parallel loop and with more threads than energy blocks, and its energy with a gradient is
-// bitwise the energy-only sum; and the spring stencil refuses a spring set numbered otherwise.
+// bitwise the energy-only sum; the same for the volume kernel against a gather of all cells'
+// coefficients; and the spring stencil refuses a spring set numbered otherwise.
 
 #include "mresim/mess/terms/grid_stencil.hpp"
 
@@ -17,6 +18,7 @@
 #include <vector>
 
 #include "../support/mess_test_support.hpp"
+#include "mresim/mess/terms/elastic_formulas.hpp"
 #include "mresim/mess/terms/elastic_terms.hpp"
 
 namespace mess = mresim::mess;
@@ -92,6 +94,35 @@ void expect_kernel_matches_reference(const lat::Lattice& l) {
   });
   EXPECT_TRUE(product == expected_product)
       << "largest difference " << (product - expected_product).cwiseAbs().maxCoeff();
+}
+
+// The volume kernel's gradient against a pass over all cells into an array and the stencil's
+// gather (what the kernel did before its layer buffers), and its energy against the energy-only
+// sum, bitwise.
+void expect_volume_kernel_matches_reference(const lat::Lattice& l, double force_factor) {
+  const Eigen::Matrix3Xd x = perturbed(l.positions, 0.1 * l.element_length, 5);
+  const Eigen::Matrix3Xd start = perturbed(Eigen::Matrix3Xd::Zero(3, x.cols()), 1e-3, 8);
+  const mess::VolumeKernel kernel(l);
+  Eigen::Matrix3Xd gradient = start;
+  const mess::ElasticValue with_gradient = kernel.evaluate(l, x, force_factor, &gradient);
+  const mess::ElasticValue energy_only = kernel.evaluate(l, x, force_factor, nullptr);
+  EXPECT_EQ(with_gradient.energy, energy_only.energy);
+  EXPECT_EQ(with_gradient.rounding, energy_only.rounding);
+
+  const double v0 = l.element_length * l.element_length * l.element_length;
+  std::vector<double> terms(9 * l.elements.size());
+  for (std::size_t c = 0; c < l.elements.size(); ++c) {
+    lat::CellVertices vertices;
+    for (int k = 0; k < 8; ++k) vertices[k] = x.col(l.elements[c][static_cast<std::size_t>(k)]);
+    (void)mess::elastic::cell_value(vertices, l.polymer.kappa, v0, force_factor,
+                                    terms.data() + 9 * c);
+  }
+  Eigen::Matrix3Xd expected = start;
+  mess::CellStencil(l.shape).gather(expected, [&](std::int64_t cell, int v) {
+    return mess::elastic::vertex_gradient(terms.data() + 9 * cell, v);
+  });
+  EXPECT_TRUE(gradient == expected)
+      << "largest difference " << (gradient - expected).cwiseAbs().maxCoeff();
 }
 
 // Boxes of one cell, thin along each axis, and cubic.
@@ -197,3 +228,31 @@ TEST(SpringStencil, RefusesSpringsNumberedOtherwise) {
   missing.springs.second.pop_back();
   EXPECT_THROW(mess::SpringStencil{missing}, std::invalid_argument);
 }
+
+TEST(VolumeKernel, GradientMatchesTheReferenceOnSmallBoxes) {
+  const mess::ModelProfile physical = mess::model_profile("physical");
+  for (const std::array<int, 3> cells : kSmallBoxes) {
+    SCOPED_TRACE(::testing::Message() << cells[0] << " x " << cells[1] << " x " << cells[2]);
+    expect_volume_kernel_matches_reference(small_lattice(physical, cells), 1.0);
+  }
+  expect_volume_kernel_matches_reference(small_lattice(physical, {5, 5, 6}, {{2, 2, 2}}), 4.0);
+}
+
+TEST(VolumeKernel, GradientMatchesTheReferenceOnEveryThreadCount) {
+  // Layers of 256 cells (many per energy block), and layers of 4,200 cells (more than a block:
+  // a thread's blocks can lie inside one layer, and with 8 threads some own no plane at all).
+  const mess::ModelProfile seed = mess::model_profile("seed");
+  const lat::Lattice thin_layers = small_lattice(seed, {16, 16, 24}, {{8, 8, 6}, {8, 8, 16}});
+  const lat::Lattice wide_layers = small_lattice(seed, {70, 60, 5});
+  ASSERT_GE(static_cast<std::int64_t>(wide_layers.elements.size()),
+            mess::detail::kParallelMinimum);
+  const int saved = omp_get_max_threads();
+  for (const int threads : {1, 2, 3, 8}) {
+    SCOPED_TRACE(threads);
+    omp_set_num_threads(threads);
+    expect_volume_kernel_matches_reference(thin_layers, 4.0);
+    expect_volume_kernel_matches_reference(wide_layers, 1.0);
+  }
+  omp_set_num_threads(saved);
+}
+

@@ -80,6 +80,68 @@ namespace {
 // Nodes whose springs evaluate_with_gradient computes in one flat pass before gathering them.
 constexpr std::int64_t kChunkNodes = 512;
 
+// The energy sums of the fused kernels, bitwise those of detail::fixed_order_sums: the items
+// are split into the same blocks of kSumBlock, each thread takes a contiguous run of blocks
+// (own_items) and sums each of them serially in index order (OwnBlockSums), and the block sums
+// are added in block order (total_of).
+struct ItemRange {
+  std::int64_t begin = 0;
+  std::int64_t end = 0;
+};
+
+ItemRange own_items(std::int64_t items, std::int64_t thread, std::int64_t threads) {
+  const std::int64_t blocks = (items + detail::kSumBlock - 1) / detail::kSumBlock;
+  return {std::min(items, blocks * thread / threads * detail::kSumBlock),
+          std::min(items, blocks * (thread + 1) / threads * detail::kSumBlock)};
+}
+
+// One thread's block sums of (energy, rounding); items outside its own range are ignored (a
+// thread also computes some of its neighbours' items, which they sum).
+class OwnBlockSums {
+ public:
+  OwnBlockSums(ItemRange own, std::vector<std::array<double, 2>>& partial)
+      : own_(own), partial_(partial) {}
+  OwnBlockSums(const OwnBlockSums&) = delete;
+  OwnBlockSums& operator=(const OwnBlockSums&) = delete;
+  ~OwnBlockSums() { flush(); }
+
+  // Items must come in increasing index.
+  void add(std::int64_t item, double energy, double rounding) {
+    if (item < own_.begin || item >= own_.end) return;
+    if (item / detail::kSumBlock != block_) {
+      flush();
+      block_ = item / detail::kSumBlock;
+    }
+    sum_[0] += energy;
+    sum_[1] += rounding;
+  }
+
+ private:
+  void flush() {
+    if (block_ >= 0) partial_[static_cast<std::size_t>(block_)] = sum_;
+    sum_ = {0.0, 0.0};
+  }
+
+  ItemRange own_;
+  std::vector<std::array<double, 2>>& partial_;
+  std::int64_t block_ = -1;
+  std::array<double, 2> sum_{0.0, 0.0};
+};
+
+std::vector<std::array<double, 2>> block_partials(std::int64_t items) {
+  return std::vector<std::array<double, 2>>(
+      static_cast<std::size_t>((items + detail::kSumBlock - 1) / detail::kSumBlock), {0.0, 0.0});
+}
+
+ElasticValue total_of(const std::vector<std::array<double, 2>>& partial) {
+  std::array<double, 2> total{0.0, 0.0};
+  for (const auto& s : partial) {
+    total[0] += s[0];
+    total[1] += s[1];
+  }
+  return {total[0], total[1]};
+}
+
 // Runs body(i) for i < n, in parallel for large n; each i writes only its own scratch slot.
 template <class Body>
 void for_each_item(std::int64_t n, Body&& body) {
@@ -155,8 +217,7 @@ ElasticValue SpringKernel::evaluate_with_gradient(const lattice::Lattice& lat,
   const lattice::SpringSet& sp = lat.springs;
   const std::int64_t springs = stencil_.spring_count();
   const std::int64_t nodes = stencil_.node_count();
-  const std::int64_t blocks = (springs + detail::kSumBlock - 1) / detail::kSumBlock;
-  std::vector<std::array<double, 2>> partial(static_cast<std::size_t>(blocks), {0.0, 0.0});
+  std::vector<std::array<double, 2>> partial = block_partials(springs);
   const std::array<double, 3> rest_length = elastic::rest_lengths(sp.element_length);
   const bool parallel = springs >= detail::kParallelMinimum;
   const int max_threads = parallel ? omp_get_max_threads() : 1;
@@ -172,9 +233,7 @@ ElasticValue SpringKernel::evaluate_with_gradient(const lattice::Lattice& lat,
     const auto thread = static_cast<std::int64_t>(omp_get_thread_num());
     // This thread's energy blocks, their springs [own_begin, own_end), and the nodes whose
     // first spring lies there (the last thread also takes the last node, which has none).
-    const std::int64_t own_begin = std::min(springs, blocks * thread / threads * detail::kSumBlock);
-    const std::int64_t own_end =
-        std::min(springs, blocks * (thread + 1) / threads * detail::kSumBlock);
+    const ItemRange own = own_items(springs, thread, threads);
     const auto first_node_from = [&](std::int64_t spring) {
       std::int64_t lo = 0;
       std::int64_t hi = nodes;
@@ -188,16 +247,11 @@ ElasticValue SpringKernel::evaluate_with_gradient(const lattice::Lattice& lat,
       }
       return lo;
     };
-    const std::int64_t node_begin = first_node_from(own_begin);
-    const std::int64_t node_end = thread + 1 == threads ? nodes : first_node_from(own_end);
+    const std::int64_t node_begin = first_node_from(own.begin);
+    const std::int64_t node_end = thread + 1 == threads ? nodes : first_node_from(own.end);
     double* ring = rings_.data() + thread * ring_capacity_;
 
-    std::int64_t block = -1;
-    std::array<double, 2> block_sum{0.0, 0.0};
-    const auto flush = [&] {
-      if (block >= 0) partial[static_cast<std::size_t>(block)] = block_sum;
-      block_sum = {0.0, 0.0};
-    };
+    OwnBlockSums sums(own, partial);
     // Tensions of the springs of the nodes [next, end), in one flat pass as a whole-array
     // pass would do it, into the ring; the energy of those that are this thread's.
     std::int64_t next = std::max<std::int64_t>(0, node_begin - behind);
@@ -209,13 +263,7 @@ ElasticValue SpringKernel::evaluate_with_gradient(const lattice::Lattice& lat,
         const elastic::SpringValue value = elastic::spring_value(
             sp.stiffness[u], rest_length[static_cast<std::size_t>(sp.kind[u])], l);
         ring[static_cast<std::uint64_t>(s) & mask] = value.tension;
-        if (s < own_begin || s >= own_end) continue;
-        if (s / detail::kSumBlock != block) {
-          flush();
-          block = s / detail::kSumBlock;
-        }
-        block_sum[0] += value.energy;
-        block_sum[1] += value.rounding;
+        sums.add(s, value.energy, value.rounding);
       }
       next = end;
     };
@@ -246,14 +294,8 @@ ElasticValue SpringKernel::evaluate_with_gradient(const lattice::Lattice& lat,
         }
       }
     }
-    flush();
   }
-  std::array<double, 2> total{0.0, 0.0};
-  for (const auto& s : partial) {
-    total[0] += s[0];
-    total[1] += s[1];
-  }
-  return {total[0], total[1]};
+  return total_of(partial);
 }
 
 void SpringKernel::add_hessian_product(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
@@ -343,18 +385,87 @@ ElasticValue VolumeKernel::evaluate(const lattice::Lattice& lat, const Eigen::Ma
   const auto cells = static_cast<std::int64_t>(lat.elements.size());
   const double kappa = lat.polymer.kappa;
   const double v0 = std::pow(lat.element_length, 3);
-  const bool want_gradient = gradient != nullptr;
-  if (want_gradient) scratch_.resize(static_cast<std::size_t>(9 * cells));
-  // Energy (eq. 4.64 x V0) and the gradient coefficients of every cell (eqs. 4.66-4.69,
-  // elastic::cell_value), then the gather.
+  if (gradient != nullptr) return evaluate_with_gradient(lat, x, force_factor, *gradient);
+  // Energy (eq. 4.64 x V0) and its rounding scale.
   const auto sums = detail::fixed_order_sums(cells, [&](std::int64_t c) {
-    const elastic::CellValue value =
-        elastic::cell_value(gather_vertices(lat.elements[static_cast<std::size_t>(c)], x), kappa,
-                            v0, force_factor, want_gradient ? scratch_.data() + 9 * c : nullptr);
+    const elastic::CellValue value = elastic::cell_value(
+        gather_vertices(lat.elements[static_cast<std::size_t>(c)], x), kappa, v0, force_factor,
+        nullptr);
     return std::array<double, 2>{value.energy, value.rounding};
   });
-  if (gradient != nullptr) gather(scratch_, *gradient);
   return {sums[0], sums[1]};
+}
+
+// Every cell's gradient coefficients (eqs. 4.66-4.69, elastic::cell_value) are computed once
+// and gathered by its eight vertices in CellStencil::gather's order, and the energy is summed
+// in the blocks of detail::fixed_order_sums: bitwise the results of a pass over all cells into
+// a scratch array (9 doubles per cell) and a gather, for any thread count, without that array.
+// Cells are numbered layer by layer along z (cx + Cx (cy + Cy cz)), and the nodes of plane iz
+// hold cells of layers iz - 1 and iz only. So each thread takes a contiguous run of the energy
+// blocks, computes whole layers in order into two layer buffers (layer cz in buffer cz mod 2),
+// and gathers plane iz once layer iz is done. It owns the planes whose first cell lies in its
+// blocks (the last thread also the top plane, which starts no layer); it first computes the
+// layer below its first plane, and its last layer may reach into the next thread's blocks; the
+// energy counts only its own blocks.
+ElasticValue VolumeKernel::evaluate_with_gradient(const lattice::Lattice& lat,
+                                                  const Eigen::Matrix3Xd& x, double force_factor,
+                                                  Eigen::Matrix3Xd& gradient) const {
+  const auto cells = static_cast<std::int64_t>(lat.elements.size());
+  if (cells == 0) return {0.0, 0.0};
+  const double kappa = lat.polymer.kappa;
+  const double v0 = std::pow(lat.element_length, 3);
+  const int nx = lat.shape.nx();
+  const int ny = lat.shape.ny();
+  const int nz = lat.shape.nz();
+  const std::int64_t layer = std::int64_t{nx - 1} * (ny - 1);  // cells per layer
+  const std::int64_t layers = cells / layer;                     // nz - 1
+  std::vector<std::array<double, 2>> partial = block_partials(cells);
+  const bool parallel = cells >= detail::kParallelMinimum;
+  const int max_threads = parallel ? omp_get_max_threads() : 1;
+  layer_buffers_.resize(static_cast<std::size_t>(max_threads * 2 * 9 * layer));
+
+#pragma omp parallel if (parallel)
+  {
+    const auto threads = static_cast<std::int64_t>(omp_get_num_threads());
+    const auto thread = static_cast<std::int64_t>(omp_get_thread_num());
+    const ItemRange own = own_items(cells, thread, threads);
+    // Planes [plane_begin, plane_end): those whose first cell (plane x layer) is in own.
+    const std::int64_t plane_begin = (own.begin + layer - 1) / layer;
+    const std::int64_t plane_end = thread + 1 == threads ? nz : (own.end + layer - 1) / layer;
+    // Layers to compute: below the first plane, through the last plane's, and all own cells.
+    const std::int64_t layer_begin =
+        std::max<std::int64_t>(0, std::min(plane_begin - 1, own.begin / layer));
+    const std::int64_t layer_end = std::min(
+        layers, std::max(plane_end, own.end > own.begin ? (own.end - 1) / layer + 1 : 0));
+    double* buffers = layer_buffers_.data() + thread * 2 * 9 * layer;
+    OwnBlockSums sums(own, partial);
+    const auto gather_plane = [&](std::int64_t iz) {
+      for (int iy = 0; iy < ny; ++iy) {
+        for (int ix = 0; ix < nx; ++ix) {
+          const std::int64_t n = iz + std::int64_t{nz} * (ix + std::int64_t{nx} * iy);
+          gradient.col(n) = stencil_.gather_node(
+              ix, iy, static_cast<int>(iz), gradient.col(n), [&](std::int64_t cell, int v) {
+                const std::int64_t cz = cell / layer;
+                return elastic::vertex_gradient(
+                    buffers + 9 * ((cz & 1) * layer + (cell - cz * layer)), v);
+              });
+        }
+      }
+    };
+    for (std::int64_t cz = layer_begin; cz < layer_end; ++cz) {
+      double* t = buffers + 9 * (cz & 1) * layer;
+      for (std::int64_t c = cz * layer; c < (cz + 1) * layer; ++c, t += 9) {
+        const elastic::CellValue value = elastic::cell_value(
+            gather_vertices(lat.elements[static_cast<std::size_t>(c)], x), kappa, v0,
+            force_factor, t);
+        sums.add(c, value.energy, value.rounding);
+      }
+      if (cz >= plane_begin && cz < plane_end) gather_plane(cz);
+    }
+    // The top plane holds cells of the last layer only.
+    if (plane_end == nz && plane_begin <= nz - 1) gather_plane(nz - 1);
+  }
+  return total_of(partial);
 }
 
 void VolumeKernel::add_hessian_product(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,

@@ -71,10 +71,10 @@ struct ElasticEnergies {
 // The two elastic kernels, parallelised with OpenMP so that every result is bitwise
 // independent of the thread count: every spring's tension and every cell's volume derivative
 // is computed once, then every node gathers its own contributions in a fixed order (increasing
-// spring or cell index, found by the grid stencils of grid_stencil.hpp). The cells' derivatives
-// go to a scratch array; the springs' tensions to a small ring per thread, each thread
-// sweeping its share of the springs in index order and gathering every node as soon as its
-// springs are done (SpringKernel::evaluate). Energies are summed in
+// spring or cell index, found by the grid stencils of grid_stencil.hpp). Neither keeps an array
+// over all springs or cells: each thread sweeps its share in index order into a small buffer
+// (the springs' tensions in a ring, the cells' derivatives in two layers) and gathers the nodes
+// whose contributions are all there (SpringKernel and VolumeKernel::evaluate_with_gradient). Energies are summed in
 // fixed blocks (fixed_order.hpp). Gradients and Hessian products are ADDED per node in the order g
 // = out.col(n); g += contributions; out.col(n) = g, so a springs pass followed by a volume pass
 // gives the same bits as one fused pass. Not safe for concurrent calls on one object (the scratch
@@ -147,11 +147,16 @@ class VolumeKernel {
  private:
   // Node gather of per-cell vectors t (9 per cell: the s_a, s_b, s_c coefficients).
   void gather(const std::vector<double>& terms, Eigen::Matrix3Xd& out) const;
+  // evaluate with a gradient: cells layer by layer, each node plane gathered from two layers.
+  ElasticValue evaluate_with_gradient(const lattice::Lattice& lattice, const Eigen::Matrix3Xd& x,
+                                      double force_factor, Eigen::Matrix3Xd& gradient) const;
 
   std::int64_t node_count_ = 0;
   CellStencil stencil_;  // node -> the cells holding it, from the grid
-  // Scratch: per cell the three vectors t_a, t_b, t_c (see gather).
+  // Scratch of the Hessian product: per cell the three vectors t_a, t_b, t_c (see gather).
   mutable std::vector<double> scratch_;
+  // evaluate_with_gradient's two layers of cell coefficients per thread.
+  mutable std::vector<double> layer_buffers_;
 };
 
 // Both kernels, as one evaluator of springs + volume (used by tests and benchmarks; the

@@ -166,6 +166,12 @@ class CellStencil {
   template <class Contribution>
   void gather(Eigen::Matrix3Xd& out, Contribution&& contribution) const;
 
+  // The same for the node at grid coordinates (ix, iy, iz): returns g plus its cells'
+  // contributions, in increasing cell index.
+  template <class Contribution>
+  Eigen::Vector3d gather_node(int ix, int iy, int iz, Eigen::Vector3d g,
+                              Contribution&& contribution) const;
+
  private:
   lattice::GridShape shape_;
 };
@@ -175,8 +181,6 @@ void CellStencil::gather(Eigen::Matrix3Xd& out, Contribution&& contribution) con
   const int nx = shape_.nx();
   const int ny = shape_.ny();
   const int nz = shape_.nz();
-  const std::int64_t cx = nx - 1;
-  const std::int64_t cy = ny - 1;
   const std::int64_t rows = std::int64_t{nx} * ny;  // node index = iz + nz (ix + nx iy)
 #pragma omp parallel for schedule(static) if (rows * nz >= detail::kParallelMinimum / 4)
   for (std::int64_t row = 0; row < rows; ++row) {
@@ -184,22 +188,32 @@ void CellStencil::gather(Eigen::Matrix3Xd& out, Contribution&& contribution) con
     const int iy = static_cast<int>(row / nx);
     for (int iz = 0; iz < nz; ++iz) {
       const std::int64_t n = iz + nz * row;
-      // Away from the box's faces all eight cells exist (the usual case).
-      const bool inside = ix > 0 && ix < nx - 1 && iy > 0 && iy < ny - 1 && iz > 0 && iz < nz - 1;
-      const std::int64_t corner_cell = ix + cx * (iy + cy * iz);  // the cell at offset (0, 0, 0)
-      Eigen::Vector3d g = out.col(n);
-#pragma GCC unroll 8
-      for (const auto& [dx, dy, dz] : kCellsOfNode) {
-        if (!inside && (ix - dx < 0 || ix - dx >= nx - 1 || iy - dy < 0 || iy - dy >= ny - 1 ||
-                        iz - dz < 0 || iz - dz >= nz - 1)) {
-          continue;
-        }
-        const std::int64_t cell = corner_cell - (dx + cx * (dy + cy * dz));
-        g += contribution(cell, 2 * dx + 4 * dy + dz);
-      }
-      out.col(n) = g;
+      out.col(n) = gather_node(ix, iy, iz, out.col(n), contribution);
     }
   }
+}
+
+template <class Contribution>
+Eigen::Vector3d CellStencil::gather_node(int ix, int iy, int iz, Eigen::Vector3d g,
+                                         Contribution&& contribution) const {
+  const int nx = shape_.nx();
+  const int ny = shape_.ny();
+  const int nz = shape_.nz();
+  const std::int64_t cx = nx - 1;
+  const std::int64_t cy = ny - 1;
+  // Away from the box's faces all eight cells exist (the usual case).
+  const bool inside = ix > 0 && ix < nx - 1 && iy > 0 && iy < ny - 1 && iz > 0 && iz < nz - 1;
+  const std::int64_t corner_cell = ix + cx * (iy + cy * iz);  // the cell at offset (0, 0, 0)
+#pragma GCC unroll 8
+  for (const auto& [dx, dy, dz] : kCellsOfNode) {
+    if (!inside && (ix - dx < 0 || ix - dx >= nx - 1 || iy - dy < 0 || iy - dy >= ny - 1 ||
+                    iz - dz < 0 || iz - dz >= nz - 1)) {
+      continue;
+    }
+    const std::int64_t cell = corner_cell - (dx + cx * (dy + cy * dz));
+    g += contribution(cell, 2 * dx + 4 * dy + dz);
+  }
+  return g;
 }
 
 }  // namespace mresim::mess
