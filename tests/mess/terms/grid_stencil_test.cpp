@@ -244,8 +244,7 @@ TEST(VolumeKernel, GradientMatchesTheReferenceOnEveryThreadCount) {
   const mess::ModelProfile seed = mess::model_profile("seed");
   const lat::Lattice thin_layers = small_lattice(seed, {16, 16, 24}, {{8, 8, 6}, {8, 8, 16}});
   const lat::Lattice wide_layers = small_lattice(seed, {70, 60, 5});
-  ASSERT_GE(static_cast<std::int64_t>(wide_layers.elements.size()),
-            mess::detail::kParallelMinimum);
+  ASSERT_GE(static_cast<std::int64_t>(wide_layers.elements.size()), mess::detail::kParallelMinimum);
   const int saved = omp_get_max_threads();
   for (const int threads : {1, 2, 3, 8}) {
     SCOPED_TRACE(threads);
@@ -255,4 +254,3 @@ TEST(VolumeKernel, GradientMatchesTheReferenceOnEveryThreadCount) {
   }
   omp_set_num_threads(saved);
 }
-

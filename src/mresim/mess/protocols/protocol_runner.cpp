@@ -120,8 +120,7 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
     record.iterations = r.iterations;
     record.evaluations = r.evaluations;
     record.krylov_iterations = r.krylov_iterations;
-    record.finished_by =
-        finished_by_name(r, spec_.solver.method == mc::SolverMethod::newton);
+    record.finished_by = finished_by_name(r, spec_.solver.method == mc::SolverMethod::newton);
     record.correction_passes = r.correction_passes;
     record.max_force = r.max_force;
     record.energies = r.final.energies;

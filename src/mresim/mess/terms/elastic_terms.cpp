@@ -174,8 +174,9 @@ SpringKernel::SpringKernel(const lattice::Lattice& lat)
   // A node's backward springs come from the max_delta() nodes below it, so a ring holding the
   // springs of that many nodes plus the node itself (13 springs each at most) never overwrites
   // a tension that a later gather still reads. No larger than the whole set is needed.
-  const std::int64_t needed = std::min<std::int64_t>(13 * (stencil_.max_delta() + kChunkNodes + 1),
-                                                     std::max<std::int64_t>(stencil_.spring_count(), 1));
+  const std::int64_t needed =
+      std::min<std::int64_t>(13 * (stencil_.max_delta() + kChunkNodes + 1),
+                             std::max<std::int64_t>(stencil_.spring_count(), 1));
   ring_capacity_ = 1;
   while (ring_capacity_ < needed) ring_capacity_ *= 2;
 }
@@ -281,9 +282,8 @@ ElasticValue SpringKernel::evaluate_with_gradient(const lattice::Lattice& lat,
           return Eigen::Vector3d(ring[static_cast<std::uint64_t>(s) & mask] * r);
         };
         Eigen::Vector3d g = stencil_.gather_backward(n, ix, iy, iz, gradient.col(n), contribution);
-        stencil_.for_each_forward_spring(n, [&](std::int64_t s, int, std::int64_t second) {
-          g -= contribution(s, n, second);
-        });
+        stencil_.for_each_forward_spring(
+            n, [&](std::int64_t s, int, std::int64_t second) { g -= contribution(s, n, second); });
         gradient.col(n) = g;
         if (++iz == nz) {
           iz = 0;
@@ -388,9 +388,9 @@ ElasticValue VolumeKernel::evaluate(const lattice::Lattice& lat, const Eigen::Ma
   if (gradient != nullptr) return evaluate_with_gradient(lat, x, force_factor, *gradient);
   // Energy (eq. 4.64 x V0) and its rounding scale.
   const auto sums = detail::fixed_order_sums(cells, [&](std::int64_t c) {
-    const elastic::CellValue value = elastic::cell_value(
-        gather_vertices(lat.elements[static_cast<std::size_t>(c)], x), kappa, v0, force_factor,
-        nullptr);
+    const elastic::CellValue value =
+        elastic::cell_value(gather_vertices(lat.elements[static_cast<std::size_t>(c)], x), kappa,
+                            v0, force_factor, nullptr);
     return std::array<double, 2>{value.energy, value.rounding};
   });
   return {sums[0], sums[1]};
@@ -418,7 +418,7 @@ ElasticValue VolumeKernel::evaluate_with_gradient(const lattice::Lattice& lat,
   const int ny = lat.shape.ny();
   const int nz = lat.shape.nz();
   const std::int64_t layer = std::int64_t{nx - 1} * (ny - 1);  // cells per layer
-  const std::int64_t layers = cells / layer;                     // nz - 1
+  const std::int64_t layers = cells / layer;                   // nz - 1
   std::vector<std::array<double, 2>> partial = block_partials(cells);
   const bool parallel = cells >= detail::kParallelMinimum;
   const int max_threads = parallel ? omp_get_max_threads() : 1;
@@ -435,8 +435,8 @@ ElasticValue VolumeKernel::evaluate_with_gradient(const lattice::Lattice& lat,
     // Layers to compute: below the first plane, through the last plane's, and all own cells.
     const std::int64_t layer_begin =
         std::max<std::int64_t>(0, std::min(plane_begin - 1, own.begin / layer));
-    const std::int64_t layer_end = std::min(
-        layers, std::max(plane_end, own.end > own.begin ? (own.end - 1) / layer + 1 : 0));
+    const std::int64_t layer_end =
+        std::min(layers, std::max(plane_end, own.end > own.begin ? (own.end - 1) / layer + 1 : 0));
     double* buffers = layer_buffers_.data() + thread * 2 * 9 * layer;
     OwnBlockSums sums(own, partial);
     const auto gather_plane = [&](std::int64_t iz) {
@@ -455,9 +455,9 @@ ElasticValue VolumeKernel::evaluate_with_gradient(const lattice::Lattice& lat,
     for (std::int64_t cz = layer_begin; cz < layer_end; ++cz) {
       double* t = buffers + 9 * (cz & 1) * layer;
       for (std::int64_t c = cz * layer; c < (cz + 1) * layer; ++c, t += 9) {
-        const elastic::CellValue value = elastic::cell_value(
-            gather_vertices(lat.elements[static_cast<std::size_t>(c)], x), kappa, v0,
-            force_factor, t);
+        const elastic::CellValue value =
+            elastic::cell_value(gather_vertices(lat.elements[static_cast<std::size_t>(c)], x),
+                                kappa, v0, force_factor, t);
         sums.add(c, value.energy, value.rounding);
       }
       if (cz >= plane_begin && cz < plane_end) gather_plane(cz);

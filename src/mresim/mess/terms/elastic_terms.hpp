@@ -74,11 +74,12 @@ struct ElasticEnergies {
 // spring or cell index, found by the grid stencils of grid_stencil.hpp). Neither keeps an array
 // over all springs or cells: each thread sweeps its share in index order into a small buffer
 // (the springs' tensions in a ring, the cells' derivatives in two layers) and gathers the nodes
-// whose contributions are all there (SpringKernel and VolumeKernel::evaluate_with_gradient). Energies are summed in
-// fixed blocks (fixed_order.hpp). Gradients and Hessian products are ADDED per node in the order g
-// = out.col(n); g += contributions; out.col(n) = g, so a springs pass followed by a volume pass
-// gives the same bits as one fused pass. Not safe for concurrent calls on one object (the scratch
-// arrays are shared); copies are independent. `lattice` must be the one given to the constructor.
+// whose contributions are all there (SpringKernel and VolumeKernel::evaluate_with_gradient).
+// Energies are summed in fixed blocks (fixed_order.hpp). Gradients and Hessian products are ADDED
+// per node in the order g = out.col(n); g += contributions; out.col(n) = g, so a springs pass
+// followed by a volume pass gives the same bits as one fused pass. Not safe for concurrent calls on
+// one object (the scratch arrays are shared); copies are independent. `lattice` must be the one
+// given to the constructor.
 
 struct ElasticValue {
   double energy = 0.0;    // J

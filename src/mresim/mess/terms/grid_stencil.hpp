@@ -124,9 +124,8 @@ void SpringStencil::gather(Eigen::Matrix3Xd& out, Contribution&& contribution) c
     for (int iz = 0; iz < nz; ++iz) {
       const std::int64_t n = iz + nz * row;
       Eigen::Vector3d g = gather_backward(n, ix, iy, iz, out.col(n), contribution);
-      for_each_forward_spring(n, [&](std::int64_t s, int, std::int64_t second) {
-        g -= contribution(s, n, second);
-      });
+      for_each_forward_spring(
+          n, [&](std::int64_t s, int, std::int64_t second) { g -= contribution(s, n, second); });
       out.col(n) = g;
     }
   }
