@@ -172,8 +172,9 @@ void check_shapes(const char* who, std::int64_t node_count, const lattice::Latti
 SpringKernel::SpringKernel(const lattice::Lattice& lat)
     : node_count_(lat.node_count()), stencil_(lat) {
   // A node's backward springs come from the max_delta() nodes below it, so a ring holding the
-  // springs of that many nodes plus the node itself (13 springs each at most) never overwrites
-  // a tension that a later gather still reads. No larger than the whole set is needed.
+  // springs of that many nodes plus a chunk of kChunkNodes (13 springs each at most) never
+  // overwrites a tension that the chunk's gather still reads. No larger than the whole set is
+  // needed.
   const std::int64_t needed =
       std::min<std::int64_t>(13 * (stencil_.max_delta() + kChunkNodes + 1),
                              std::max<std::int64_t>(stencil_.spring_count(), 1));
@@ -206,12 +207,13 @@ ElasticValue SpringKernel::evaluate(const lattice::Lattice& lat, const Eigen::Ma
 // scratch array and a gather, for any thread count. Instead of an array of all tensions
 // (8 bytes per spring, written and read back), each thread keeps a ring of the last
 // ring_capacity_ tensions: it takes a contiguous run of the energy blocks and sweeps their
-// nodes in index order. Each node first gathers its backward springs from the ring (they come
-// from the max_delta() nodes below it, computed earlier), then computes its forward springs
-// (from their ends on the grid, no index arrays), subtracts them at once and leaves their
-// tensions in the ring. A thread first computes the springs of the max_delta() nodes before
-// its own (those tensions are the previous thread's to sum), and the forward springs of its
-// last node may reach into the next thread's blocks; the energy counts only its own blocks.
+// nodes in index order, a chunk of kChunkNodes at a time: one flat pass computes the chunk's
+// springs into the ring (the fastest form measured: docs/performance.md), then each node of
+// the chunk gathers its springs from the ring (its backward ones come from the max_delta()
+// nodes below it, computed earlier). A thread first computes the springs of the max_delta()
+// nodes before its own (those tensions are the previous thread's to sum), and the forward
+// springs of its last node may reach into the next thread's blocks; the energy counts only its
+// own blocks.
 ElasticValue SpringKernel::evaluate_with_gradient(const lattice::Lattice& lat,
                                                   const Eigen::Matrix3Xd& x,
                                                   Eigen::Matrix3Xd& gradient) const {
@@ -232,8 +234,8 @@ ElasticValue SpringKernel::evaluate_with_gradient(const lattice::Lattice& lat,
   {
     const auto threads = static_cast<std::int64_t>(omp_get_num_threads());
     const auto thread = static_cast<std::int64_t>(omp_get_thread_num());
-    // This thread's energy blocks, their springs [own_begin, own_end), and the nodes whose
-    // first spring lies there (the last thread also takes the last node, which has none).
+    // This thread's energy blocks, their springs `own`, and the nodes whose first spring lies
+    // there (the last thread also takes the last node, which has none).
     const ItemRange own = own_items(springs, thread, threads);
     const auto first_node_from = [&](std::int64_t spring) {
       std::int64_t lo = 0;
