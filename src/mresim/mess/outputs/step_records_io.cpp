@@ -114,6 +114,7 @@ void write_step_records(io::Hdf5File& file, const std::string& group,
   file.write_int_vector(s + "krylov_iterations",
                         int_column(records, [](auto& r) { return r.krylov_iterations; }));
   std::vector<std::string> finished_by;
+  finished_by.reserve(records.size());
   for (const StepRecord& r : records) finished_by.push_back(r.finished_by);
   file.write_string_vector(s + "finished_by", finished_by);
   file.write_int_vector(s + "correction_passes",

@@ -223,7 +223,7 @@ ElasticValue SpringKernel::evaluate_with_gradient(const lattice::Lattice& lat,
   std::vector<std::array<double, 2>> partial = block_partials(springs);
   const std::array<double, 3> rest_length = elastic::rest_lengths(sp.element_length);
   const bool parallel = springs >= detail::kParallelMinimum;
-  const int max_threads = parallel ? omp_get_max_threads() : 1;
+  const std::int64_t max_threads = parallel ? omp_get_max_threads() : 1;
   rings_.resize(static_cast<std::size_t>(max_threads * ring_capacity_));
   const int nz = lat.shape.nz();
   const int nx = lat.shape.nx();
@@ -423,7 +423,7 @@ ElasticValue VolumeKernel::evaluate_with_gradient(const lattice::Lattice& lat,
   const std::int64_t layers = cells / layer;                   // nz - 1
   std::vector<std::array<double, 2>> partial = block_partials(cells);
   const bool parallel = cells >= detail::kParallelMinimum;
-  const int max_threads = parallel ? omp_get_max_threads() : 1;
+  const std::int64_t max_threads = parallel ? omp_get_max_threads() : 1;
   layer_buffers_.resize(static_cast<std::size_t>(max_threads * 2 * 9 * layer));
 
 #pragma omp parallel if (parallel)
