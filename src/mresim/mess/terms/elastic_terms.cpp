@@ -160,6 +160,16 @@ Eigen::Matrix3d spring_block(const lattice::SpringSet& sp, std::size_t s,
          ((1.0 - ratio) * Eigen::Matrix3d::Identity() + ratio * u * u.transpose());
 }
 
+// Spring s of the set at positions x (eqs. 4.62-4.63), with the rest lengths by kind.
+elastic::SpringValue spring_at(const lattice::SpringSet& sp,
+                               const std::array<double, 3>& rest_length, const Eigen::Matrix3Xd& x,
+                               std::int64_t s) {
+  const auto u = static_cast<std::size_t>(s);
+  const double l = (x.col(sp.second[u]) - x.col(sp.first[u])).norm();
+  return elastic::spring_value(sp.stiffness[u], rest_length[static_cast<std::size_t>(sp.kind[u])],
+                               l);
+}
+
 void check_shapes(const char* who, std::int64_t node_count, const lattice::Lattice& lat,
                   const Eigen::Matrix3Xd& x) {
   if (x.cols() != node_count || lat.node_count() != node_count) {
@@ -192,10 +202,7 @@ ElasticValue SpringKernel::evaluate(const lattice::Lattice& lat, const Eigen::Ma
   // Energy (eq. 4.62) and its rounding scale.
   const auto sums =
       detail::fixed_order_sums(static_cast<std::int64_t>(sp.size()), [&](std::int64_t s) {
-        const auto u = static_cast<std::size_t>(s);
-        const double l = (x.col(sp.second[u]) - x.col(sp.first[u])).norm();
-        const elastic::SpringValue value = elastic::spring_value(
-            sp.stiffness[u], rest_length[static_cast<std::size_t>(sp.kind[u])], l);
+        const elastic::SpringValue value = spring_at(sp, rest_length, x, s);
         return std::array<double, 2>{value.energy, value.rounding};
       });
   return {sums[0], sums[1]};
@@ -261,10 +268,7 @@ ElasticValue SpringKernel::evaluate_with_gradient(const lattice::Lattice& lat,
     const auto compute_through = [&](std::int64_t end) {
       const std::int64_t stop = stencil_.first_spring(end);
       for (std::int64_t s = stencil_.first_spring(next); s < stop; ++s) {
-        const auto u = static_cast<std::size_t>(s);
-        const double l = (x.col(sp.second[u]) - x.col(sp.first[u])).norm();
-        const elastic::SpringValue value = elastic::spring_value(
-            sp.stiffness[u], rest_length[static_cast<std::size_t>(sp.kind[u])], l);
+        const elastic::SpringValue value = spring_at(sp, rest_length, x, s);
         ring[static_cast<std::uint64_t>(s) & mask] = value.tension;
         sums.add(s, value.energy, value.rounding);
       }
@@ -447,7 +451,7 @@ ElasticValue VolumeKernel::evaluate_with_gradient(const lattice::Lattice& lat,
           const std::int64_t n = iz + std::int64_t{nz} * (ix + std::int64_t{nx} * iy);
           gradient.col(n) = stencil_.gather_node(
               ix, iy, static_cast<int>(iz), gradient.col(n), [&](std::int64_t cell, int v) {
-                const std::int64_t cz = cell / layer;
+                const std::int64_t cz = iz - (v & 1);  // the node is the cell's vertex dz = v & 1
                 return elastic::vertex_gradient(
                     buffers + 9 * ((cz & 1) * layer + (cell - cz * layer)), v);
               });
