@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace mresim::mess::detail {
 
@@ -25,9 +26,13 @@ bool StallGuard::stalled(const Eigen::VectorXd& g, double change, const Objectiv
 }
 
 bool wolfe_line_search(Objective& f, const Eigen::VectorXd& u, const Eigen::VectorXd& d,
-                       LinePoint start, double alpha_init, double alpha_max, bool use_energy,
-                       LinePoint& out) {
-  start.alpha = 0.0;
+                       const LinePoint& from, double alpha_init, double alpha_max,
+                       bool use_energy, LinePoint& out) {
+  // At full size every gradient is 24 bytes per node, so the search keeps only the ones it may
+  // return: not the start's (alpha = 0 is never accepted) nor the upper ends' of the zoom.
+  LinePoint start;
+  start.phi = from.phi;
+  start.dphi = from.dphi;
   constexpr double c1 = 1e-4;
   constexpr double c2 = 0.9;
   constexpr int kMaxTrials = 40;
@@ -37,7 +42,7 @@ bool wolfe_line_search(Objective& f, const Eigen::VectorXd& u, const Eigen::Vect
     last_alpha = alpha;
     LinePoint p;
     p.alpha = alpha;
-    p.phi = f(u + alpha * d, p.g);
+    p.phi = f.along(u, alpha, d, p.g);
     p.dphi = p.g.dot(d);
     return p;
   };
@@ -54,6 +59,7 @@ bool wolfe_line_search(Objective& f, const Eigen::VectorXd& u, const Eigen::Vect
   int trials = 0;
   // zoom(lo, hi): lo satisfies sufficient decrease, the minimiser lies between lo and hi.
   const auto zoom = [&](LinePoint lo, LinePoint hi) {
+    hi.g.resize(0);
     while (trials < kMaxTrials) {
       const double a = std::min(lo.alpha, hi.alpha);
       const double b = std::max(lo.alpha, hi.alpha);
@@ -64,17 +70,21 @@ bool wolfe_line_search(Objective& f, const Eigen::VectorXd& u, const Eigen::Vect
         alpha = 0.5 * (a + b);
       }
       alpha = std::clamp(alpha, a + 0.1 * (b - a), b - 0.1 * (b - a));
-      const LinePoint p = eval(alpha);
+      LinePoint p = eval(alpha);
       ++trials;
       if (armijo_fails(p) || higher(p, lo)) {
-        hi = p;
+        hi = std::move(p);
+        hi.g.resize(0);
       } else {
         if (curvature_holds(p)) {
-          out = p;
+          out = std::move(p);
           return true;
         }
-        if (p.dphi * (hi.alpha - lo.alpha) >= 0.0) hi = lo;
-        lo = p;
+        if (p.dphi * (hi.alpha - lo.alpha) >= 0.0) {
+          hi = std::move(lo);
+          hi.g.resize(0);
+        }
+        lo = std::move(p);
       }
       if (std::abs(hi.alpha - lo.alpha) < 1e-12 * std::max(lo.alpha, hi.alpha)) break;
     }
@@ -82,7 +92,7 @@ bool wolfe_line_search(Objective& f, const Eigen::VectorXd& u, const Eigen::Vect
     // the noise, or a smaller slope.
     if (lo.alpha > 0.0 && ((use_energy && lo.phi < start.phi - slack) ||
                            std::abs(lo.dphi) < 0.5 * std::abs(start.dphi))) {
-      out = lo;
+      out = std::move(lo);
       return true;
     }
     return false;
@@ -92,32 +102,32 @@ bool wolfe_line_search(Objective& f, const Eigen::VectorXd& u, const Eigen::Vect
   double alpha = std::min(alpha_init, alpha_max);
   bool ok = false;
   while (trials < kMaxTrials) {
-    const LinePoint p = eval(alpha);
+    LinePoint p = eval(alpha);
     ++trials;
     if (armijo_fails(p) || (prev.alpha > 0.0 && higher(p, prev))) {
-      ok = zoom(prev, p);
+      ok = zoom(std::move(prev), std::move(p));
       break;
     }
     if (curvature_holds(p)) {
-      out = p;
+      out = std::move(p);
       ok = true;
       break;
     }
     if (p.dphi >= 0.0) {
-      ok = zoom(p, prev);
+      ok = zoom(std::move(p), std::move(prev));
       break;
     }
     if (alpha >= alpha_max) {  // cannot go further: accept the longest allowed step
-      out = p;
+      out = std::move(p);
       ok = true;
       break;
     }
-    prev = p;
+    prev = std::move(p);
     alpha = std::min(2.0 * alpha, alpha_max);
   }
   if (ok && last_alpha != out.alpha) {
     Eigen::VectorXd g;
-    (void)f(u + out.alpha * d, g);  // leave the system at the accepted point
+    (void)f.along(u, out.alpha, d, g);  // leave the system at the accepted point
   }
   return ok;
 }

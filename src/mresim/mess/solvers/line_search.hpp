@@ -43,11 +43,12 @@ struct LinePoint {
 
 // Strong-Wolfe line search (Nocedal & Wright Alg. 3.5/3.6) along d from u, with a rounding
 // slack on the sufficient-decrease test and derivative (secant) interpolation in the zoom.
-// On success `out` holds the accepted point and the system is left at it.
+// `from`: the point at alpha = 0 (its gradient is not used). On success `out` holds the
+// accepted point and the system is left at it.
 // use_energy = false: forces only (a field that is not exactly a gradient): the energy tests
 // are dropped and the search brackets the zero of the slope g(alpha) . d.
 bool wolfe_line_search(Objective& f, const Eigen::VectorXd& u, const Eigen::VectorXd& d,
-                       LinePoint start, double alpha_init, double alpha_max, bool use_energy,
-                       LinePoint& out);
+                       const LinePoint& from, double alpha_init, double alpha_max,
+                       bool use_energy, LinePoint& out);
 
 }  // namespace mresim::mess::detail

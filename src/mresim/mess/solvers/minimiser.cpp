@@ -94,7 +94,9 @@ using detail::wolfe_line_search;
 
 // -------------------------------------------------------------------------------- L-BFGS
 
-// The L-BFGS memory: the last `size` steps s and gradient changes y, rho = 1/(s.y).
+// The L-BFGS memory: the last `size` steps s and gradient changes y, rho = 1/(s.y). A full
+// memory takes a new pair into the storage of the oldest one, so that it never holds more than
+// `size` pairs (at full size each vector is 24 bytes per node).
 class LbfgsMemory {
  public:
   using Preconditioner = std::function<Eigen::VectorXd(const Eigen::VectorXd&)>;
@@ -104,24 +106,43 @@ class LbfgsMemory {
     S_.clear();
     Y_.clear();
     rho_.clear();
+    scale_known_ = false;
   }
+  // The preconditioner may have changed (a new inner run): H0's scale is computed again.
+  void forget_scale() { scale_known_ = false; }
 
-  // Keeps the pair if it has positive curvature, dropping the oldest beyond `size`.
-  void add(Eigen::VectorXd s, Eigen::VectorXd y, int size) {
+  // Keeps the pair s = alpha d, y = g_new - g_old if it has positive curvature, dropping the
+  // oldest beyond `size`.
+  void add(double alpha, const Eigen::VectorXd& d, const Eigen::VectorXd& g_new,
+           const Eigen::VectorXd& g_old, int size) {
+    const auto s = alpha * d;
+    const auto y = g_new - g_old;
     const double sy = s.dot(y);
     if (!(sy > 1e-12 * y.squaredNorm() && sy > 0.0)) return;
-    S_.push_back(std::move(s));
-    Y_.push_back(std::move(y));
-    rho_.push_back(1.0 / sy);
-    if (static_cast<int>(S_.size()) > size) {
+    Eigen::VectorXd s_store;
+    Eigen::VectorXd y_store;
+    if (static_cast<int>(S_.size()) >= size) {
+      s_store = std::move(S_.front());
+      y_store = std::move(Y_.front());
       S_.pop_front();
       Y_.pop_front();
       rho_.pop_front();
     }
+    s_store = s;
+    y_store = y;
+    S_.push_back(std::move(s_store));
+    Y_.push_back(std::move(y_store));
+    rho_.push_back(1.0 / sy);
+    while (static_cast<int>(S_.size()) > size) {  // a smaller size than before
+      S_.pop_front();
+      Y_.pop_front();
+      rho_.pop_front();
+    }
+    scale_known_ = false;
   }
 
-  // H g by the two-loop recursion (N&W Alg. 7.4), H0 = (s.y / y.P y) P.
-  Eigen::VectorXd times(const Eigen::VectorXd& g, const Preconditioner& P) const {
+  // H g by the two-loop recursion (N&W Alg. 7.4), H0 = (s.y / y.P y) P with the newest pair.
+  Eigen::VectorXd times(const Eigen::VectorXd& g, const Preconditioner& P) {
     Eigen::VectorXd q = g;
     std::vector<double> a(S_.size());
     for (int i = static_cast<int>(S_.size()) - 1; i >= 0; --i) {
@@ -130,7 +151,11 @@ class LbfgsMemory {
       q -= a[k] * Y_[k];
     }
     if (!S_.empty()) {
-      q = P(q) * (S_.back().dot(Y_.back()) / Y_.back().dot(P(Y_.back())));
+      if (!scale_known_) {  // one preconditioner application per new pair, not per call
+        scale_ = S_.back().dot(Y_.back()) / Y_.back().dot(P(Y_.back()));
+        scale_known_ = true;
+      }
+      q = P(q) * scale_;
     } else {
       q = P(q);
     }
@@ -145,6 +170,8 @@ class LbfgsMemory {
   std::deque<Eigen::VectorXd> S_;
   std::deque<Eigen::VectorXd> Y_;
   std::deque<double> rho_;
+  double scale_ = 1.0;  // s.y / y.P y of the newest pair, once scale_known_
+  bool scale_known_ = false;
 };
 
 // `precondition`: P of H0 = gamma P (null: the identity). `memory`: the pairs to start from
@@ -167,11 +194,13 @@ InnerResult run_lbfgs(Objective& f, Eigen::VectorXd& u, int budget, const Minimi
     r.status = MinimiserStatus::converged;
     return r;
   }
+  memory.forget_scale();
   int failures = 0;
   constexpr int kStallIterations = 50;
   StallGuard guard(cur.g, kStallIterations);
   while (r.iterations < budget) {
-    Eigen::VectorXd d = -memory.times(cur.g, P);
+    Eigen::VectorXd d = memory.times(cur.g, P);
+    d = -d;  // in place: no second vector
     cur.dphi = cur.g.dot(d);
     if (!(cur.dphi < 0.0)) {  // not a descent direction: restart from steepest descent
       memory.clear();
@@ -196,11 +225,9 @@ InnerResult run_lbfgs(Objective& f, Eigen::VectorXd& u, int budget, const Minimi
       continue;
     }
     failures = 0;
-    Eigen::VectorXd s = next.alpha * d;
-    Eigen::VectorXd y = next.g - cur.g;
-    u += s;
+    u += next.alpha * d;
     r.energy_change = next.phi - cur.phi;
-    memory.add(std::move(s), std::move(y), opt.lbfgs_memory);
+    memory.add(next.alpha, d, next.g, cur.g, opt.lbfgs_memory);
     cur = std::move(next);
     if (guard.stalled(cur.g, r.energy_change, f, use_energy)) {
       r.status = MinimiserStatus::stalled;

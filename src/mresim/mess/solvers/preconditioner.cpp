@@ -29,7 +29,7 @@ RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& syste
 
   // Per dof (group dofs: sum over the group's nodes), scaled.
   const double scale = l_e / force_scale;
-  diagonal_ = Eigen::VectorXd::Zero(map.size());
+  Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(map.size());
   double polymer_sum = 0.0;
   std::int64_t polymer_count = 0;
   for (std::int64_t n = 0; n < lat.node_count(); ++n) {
@@ -38,17 +38,17 @@ RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& syste
     for (int a = 0; a < 3; ++a) {
       const Eigen::Index k = map.dof_of(n, a);
       if (k < 0) continue;
-      diagonal_[k] += d(a, n) * scale;
+      diagonal[k] += d(a, n) * scale;
       if (!particle) {
         polymer_sum += d(a, n) * scale;
         ++polymer_count;
       }
     }
   }
-  for (Eigen::Index k = 0; k < diagonal_.size(); ++k) {
-    if (!(diagonal_[k] > 0.0)) diagonal_[k] = 1.0;
+  for (Eigen::Index k = 0; k < diagonal.size(); ++k) {
+    if (!(diagonal[k] > 0.0)) diagonal[k] = 1.0;
   }
-  inverse_diagonal_ = diagonal_.cwiseInverse();
+  inverse_diagonal_ = diagonal.cwiseInverse();
   rigid_stiffness_ = polymer_count > 0 ? polymer_sum / static_cast<double>(polymer_count) : 1.0;
 
   // Rigid-motion bases of the particles whose coordinates are all plain free dofs.

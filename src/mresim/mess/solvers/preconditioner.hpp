@@ -36,11 +36,8 @@ class RigidParticlePreconditioner {
   // P v.
   Eigen::VectorXd apply(const Eigen::VectorXd& v) const;
 
-  const Eigen::VectorXd& diagonal() const { return diagonal_; }
-
  private:
-  Eigen::VectorXd inverse_diagonal_;
-  Eigen::VectorXd diagonal_;
+  Eigen::VectorXd inverse_diagonal_;  // D^-1 (only the inverse is kept: 24 bytes per node)
   double rigid_stiffness_ = 1.0;
   struct Block {
     std::vector<Eigen::Index> dofs;  // 3 n_p, node by node

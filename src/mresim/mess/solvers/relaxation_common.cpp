@@ -26,9 +26,7 @@ ForceMeasure::ForceMeasure(const MessSystem& system, const DofMap& map)
     : map_(map), particles_(system.lattice().particle_nodes), fixed_(system.constraints().fixed) {}
 
 double ForceMeasure::max_force(const Eigen::Matrix3Xd& gradient) const {
-  double m = 0.0;
-  const Eigen::VectorXd reduced = map_.reduce(gradient) / map_.length_scale();
-  if (reduced.size() > 0) m = reduced.cwiseAbs().maxCoeff();
+  double m = map_.max_abs_reduced_divided(gradient, map_.length_scale());
   for (const auto& nodes : particles_) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (const std::int32_t n : nodes) {
@@ -52,23 +50,48 @@ Objective::Objective(MessSystem& system, const DofMap& map, double force_scale,
 
 double Objective::operator()(const Eigen::VectorXd& u, Eigen::VectorXd& gradient) {
   map_.to_positions(u, system_.mutable_positions());
+  return evaluate_here(u, gradient);
+}
+
+double Objective::along(const Eigen::VectorXd& u, double alpha, const Eigen::VectorXd& d,
+                        Eigen::VectorXd& gradient) {
+  map_.to_positions(u, alpha, d, system_.mutable_positions());
+  return evaluate_here(u + alpha * d, gradient);
+}
+
+template <class Dofs>
+double Objective::evaluate_here(const Dofs& u, Eigen::VectorXd& gradient) {
   last_ = distributed_ != nullptr ? distributed_->evaluate(system_, &gradient_)
                                   : system_.evaluate(&gradient_);
   ++evaluations_;
-  const bool loaded = load_.size() != 0;
-  if (loaded) gradient_ += load_;
-  gradient = map_.reduce(gradient_) / e0_;
+  const bool loaded = load_origin_.size() != 0;
+  if (loaded) {
+    for (std::size_t k = 0; k < load_nodes_.size(); ++k) {
+      gradient_.col(load_nodes_[k]) += load_columns_.col(static_cast<Eigen::Index>(k));
+    }
+  }
+  map_.reduce_divided(gradient_, e0_, gradient);
   return last_.potential / e0_ + (loaded ? load_reduced_.dot(u - load_origin_) : 0.0);
 }
 
 void Objective::set_load(const Eigen::Matrix3Xd& load, const Eigen::VectorXd& u_ref) {
-  load_ = load;
-  load_reduced_ = map_.reduce(load) / e0_;
+  // The seed's correction load lives on the particle nodes only (elsewhere both centre rules
+  // give the same gradient bit for bit), so only its nonzero columns are kept.
+  load_nodes_.clear();
+  for (Eigen::Index n = 0; n < load.cols(); ++n) {
+    if (!load.col(n).isZero(0.0)) load_nodes_.push_back(static_cast<std::int32_t>(n));
+  }
+  load_columns_.resize(3, static_cast<Eigen::Index>(load_nodes_.size()));
+  for (std::size_t k = 0; k < load_nodes_.size(); ++k) {
+    load_columns_.col(static_cast<Eigen::Index>(k)) = load.col(load_nodes_[k]);
+  }
+  map_.reduce_divided(load, e0_, load_reduced_);
   load_origin_ = u_ref;
 }
 
 void Objective::clear_load() {
-  load_.resize(3, 0);
+  load_nodes_.clear();
+  load_columns_.resize(3, 0);
   load_reduced_.resize(0);
   load_origin_.resize(0);
 }

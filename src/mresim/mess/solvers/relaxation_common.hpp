@@ -45,6 +45,9 @@ class Objective {
             DistributedEvaluator* distributed = nullptr);
 
   double operator()(const Eigen::VectorXd& u, Eigen::VectorXd& gradient);
+  // The same at u + alpha d, without forming that vector (the line searches' trial points).
+  double along(const Eigen::VectorXd& u, double alpha, const Eigen::VectorXd& d,
+               Eigen::VectorXd& gradient);
 
   // A constant load added to the potential until clear_load(): gradient += `load` (3 x N,
   // J/m, the layout of full_gradient()) and potential += load . (x - x(u_ref)). The
@@ -69,9 +72,14 @@ class Objective {
   Evaluation last_;
   Eigen::Matrix3Xd gradient_;
   std::int64_t evaluations_ = 0;
-  Eigen::Matrix3Xd load_;         // empty without a load
-  Eigen::VectorXd load_reduced_;  // the load on the free variables, scaled
-  Eigen::VectorXd load_origin_;   // u_ref
+  // Evaluates the system where it stands (at dofs u) into `gradient`; returns the potential.
+  template <class Dofs>
+  double evaluate_here(const Dofs& u, Eigen::VectorXd& gradient);
+
+  std::vector<std::int32_t> load_nodes_;  // the nodes with a nonzero load
+  Eigen::Matrix3Xd load_columns_;         // their load (J/m)
+  Eigen::VectorXd load_reduced_;          // the load on the free variables, scaled
+  Eigen::VectorXd load_origin_;           // u_ref; empty without a load
 };
 
 }  // namespace mresim::mess::detail

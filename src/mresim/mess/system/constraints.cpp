@@ -1,5 +1,7 @@
 #include "mresim/mess/system/constraints.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -135,7 +137,8 @@ Eigen::VectorXd DofMap::to_dofs(const Eigen::Matrix3Xd& x) const {
   return u;
 }
 
-void DofMap::to_positions(const Eigen::VectorXd& u, Eigen::Matrix3Xd& x) const {
+template <class Dofs>
+void DofMap::write_positions(const Dofs& u, Eigen::Matrix3Xd& x) const {
   double* data = x.data();
   const auto nc = static_cast<Eigen::Index>(coordinates_.size());
   for (Eigen::Index k = 0; k < nc; ++k) {
@@ -143,26 +146,55 @@ void DofMap::to_positions(const Eigen::VectorXd& u, Eigen::Matrix3Xd& x) const {
   }
   for (Eigen::Index g = 0; g < groups(); ++g) {
     const auto gi = static_cast<std::size_t>(g);
-    const Eigen::Vector3d t = u.segment<3>(nc + 3 * g) * length_scale_;
+    const Eigen::Vector3d t = u.template segment<3>(nc + 3 * g) * length_scale_;
     for (std::size_t k = 0; k < group_nodes_[gi].size(); ++k) {
       x.col(group_nodes_[gi][k]) = group_reference_[gi].col(static_cast<Eigen::Index>(k)) + t;
     }
   }
 }
 
-Eigen::VectorXd DofMap::reduce(const Eigen::Matrix3Xd& gradient) const {
-  Eigen::VectorXd g(size());
+void DofMap::to_positions(const Eigen::VectorXd& u, Eigen::Matrix3Xd& x) const {
+  write_positions(u, x);
+}
+
+void DofMap::to_positions(const Eigen::VectorXd& u, double alpha, const Eigen::VectorXd& d,
+                          Eigen::Matrix3Xd& x) const {
+  write_positions(u + alpha * d, x);
+}
+
+template <class Visit>
+void DofMap::for_each_reduced(const Eigen::Matrix3Xd& gradient, Visit&& visit) const {
   const double* data = gradient.data();
   const auto nc = static_cast<Eigen::Index>(coordinates_.size());
   for (Eigen::Index k = 0; k < nc; ++k) {
-    g[k] = data[coordinates_[static_cast<std::size_t>(k)]] * length_scale_;
+    visit(k, data[coordinates_[static_cast<std::size_t>(k)]] * length_scale_);
   }
   for (Eigen::Index gr = 0; gr < groups(); ++gr) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (const std::int32_t n : group_nodes_[static_cast<std::size_t>(gr)]) sum += gradient.col(n);
-    g.segment<3>(nc + 3 * gr) = sum * length_scale_;
+    for (int a = 0; a < 3; ++a) visit(nc + 3 * gr + a, sum[a] * length_scale_);
   }
+}
+
+Eigen::VectorXd DofMap::reduce(const Eigen::Matrix3Xd& gradient) const {
+  Eigen::VectorXd g(size());
+  for_each_reduced(gradient, [&g](Eigen::Index k, double value) { g[k] = value; });
   return g;
+}
+
+void DofMap::reduce_divided(const Eigen::Matrix3Xd& gradient, double divisor,
+                            Eigen::VectorXd& out) const {
+  out.resize(size());
+  for_each_reduced(gradient, [&](Eigen::Index k, double value) { out[k] = value / divisor; });
+}
+
+double DofMap::max_abs_reduced_divided(const Eigen::Matrix3Xd& gradient, double divisor) const {
+  double m = 0.0;
+  for_each_reduced(gradient, [&](Eigen::Index, double value) {
+    const double a = std::abs(value / divisor);
+    if (a > m || std::isnan(a)) m = a;  // a NaN stays: it must never pass a tolerance
+  });
+  return m;
 }
 
 Eigen::Matrix3Xd DofMap::expand(const Eigen::VectorXd& v) const {

@@ -72,8 +72,15 @@ class DofMap {
   // Writes the free coordinates and group nodes of x from u; held coordinates are left as
   // they are in x.
   void to_positions(const Eigen::VectorXd& u, Eigen::Matrix3Xd& x) const;
+  // The same for u + alpha d, without forming that vector (bitwise the same positions).
+  void to_positions(const Eigen::VectorXd& u, double alpha, const Eigen::VectorXd& d,
+                    Eigen::Matrix3Xd& x) const;
   // dE/du from dE/dx (3 x N).
   Eigen::VectorXd reduce(const Eigen::Matrix3Xd& gradient) const;
+  // out = reduce(gradient) / divisor and max_k |reduce(gradient)_k / divisor|, bitwise the
+  // same, without a temporary (at full size each dof vector is 24 bytes per node).
+  void reduce_divided(const Eigen::Matrix3Xd& gradient, double divisor, Eigen::VectorXd& out) const;
+  double max_abs_reduced_divided(const Eigen::Matrix3Xd& gradient, double divisor) const;
   // The node direction (3 x N, units of l_e) that a change v of the dofs makes: free
   // coordinates take their dof, group nodes their group's translation, held coordinates 0.
   // reduce() is its transpose (times l_e).
@@ -101,6 +108,12 @@ class DofMap {
   }
 
  private:
+  template <class Dofs>
+  void write_positions(const Dofs& u, Eigen::Matrix3Xd& x) const;
+  // visit(k, dE/du_k) for every dof in order.
+  template <class Visit>
+  void for_each_reduced(const Eigen::Matrix3Xd& gradient, Visit&& visit) const;
+
   double length_scale_ = 1.0;
   // 32-bit indices (the constructor checks that 3 N fits): 24 bytes per node less than 64-bit.
   std::vector<std::int32_t> coordinates_;  // flat index 3 n + a of each free coordinate
