@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <set>
+#include <tuple>
 
 #include "mresim/mess/lattice/lattice.hpp"
 #include "mresim/mess/profile/model_profile.hpp"
@@ -25,12 +26,12 @@ struct Tally {
 Tally tally(const SpringSet& s, const SpringConstants& polymer) {
   Tally t;
   for (std::size_t i = 0; i < s.size(); ++i) {
-    const int k = static_cast<int>(s.kind[i]);
-    if (s.particle[i]) {
+    const int k = static_cast<int>(s.kind(i));
+    if (s.particle(i)) {
       ++t.particle[k];
       continue;
     }
-    const double w = s.stiffness[i] / constant_of(polymer, s.kind[i]);
+    const double w = s.stiffness(i) / constant_of(polymer, s.kind(i));
     if (std::abs(w - 0.25) < 1e-12) {
       ++t.quarter[k];
     } else if (std::abs(w - 0.5) < 1e-12) {
@@ -85,7 +86,7 @@ TEST(LatticeSprings, CountsMatchClosedForms) {
     for (std::size_t i = 0; i < s.size(); ++i) ASSERT_LT(s.first[i], s.second[i]);
     // Every cell holds exactly 12 x 1/4 edge, 12 x 1/2 face and 4 body springs' worth.
     double sum[3] = {0, 0, 0};
-    for (std::size_t i = 0; i < s.size(); ++i) sum[static_cast<int>(s.kind[i])] += s.stiffness[i];
+    for (std::size_t i = 0; i < s.size(); ++i) sum[static_cast<int>(s.kind(i))] += s.stiffness(i);
     const double cells = static_cast<double>(shape.cell_count());
     EXPECT_NEAR(sum[0], cells * 3 * kPolymer.edge, 1e-9 * sum[0]);
     EXPECT_NEAR(sum[1], cells * 6 * kPolymer.face, 1e-9 * sum[1]);
@@ -104,9 +105,9 @@ TEST(LatticeSprings, OrderOfTheOriginal) {
     EXPECT_EQ(s.first[i], 0);
     EXPECT_EQ(s.second[i], expected[i]);
   }
-  EXPECT_EQ(s.stiffness[0], kPolymer.edge / 4);  // corner: along an edge line
-  EXPECT_EQ(s.stiffness[3], kPolymer.face / 2);  // in the left face
-  EXPECT_EQ(s.stiffness[6], kPolymer.body);
+  EXPECT_EQ(s.stiffness(0), kPolymer.edge / 4);  // corner: along an edge line
+  EXPECT_EQ(s.stiffness(3), kPolymer.face / 2);  // in the left face
+  EXPECT_EQ(s.stiffness(6), kPolymer.body);
   EXPECT_DOUBLE_EQ(s.rest_length(3), std::sqrt(2.0) * kLe);
 }
 
@@ -149,9 +150,9 @@ TEST(LatticeSprings, CellCountWeightingEqualsTheOriginalsNodeTypeRules) {
         build_springs(shape, kLe, kPolymer, kParticle, {}, ParticleSpringRule::same_particle);
     const auto codes = node_type_codes(shape);
     for (std::size_t i = 0; i < s.size(); ++i) {
-      const double w = seed_weight(s.kind[i], planes_of(codes[s.first[i]], shape, s.first[i]),
+      const double w = seed_weight(s.kind(i), planes_of(codes[s.first[i]], shape, s.first[i]),
                                    planes_of(codes[s.second[i]], shape, s.second[i]));
-      ASSERT_DOUBLE_EQ(s.stiffness[i], w * constant_of(kPolymer, s.kind[i]))
+      ASSERT_DOUBLE_EQ(s.stiffness(i), w * constant_of(kPolymer, s.kind(i)))
           << "spring " << i << " of " << shape.nx() << "x" << shape.ny() << "x" << shape.nz();
     }
   }
@@ -213,10 +214,10 @@ TEST(LatticeSprings, SpringsOfOneParticle) {
   std::int64_t count[3] = {0, 0, 0}, polymer_only[3] = {0, 0, 0};
   const SpringSet& s = lat.springs;
   for (std::size_t i = 0; i < s.size(); ++i) {
-    if (!s.particle[i]) continue;
-    const int k = static_cast<int>(s.kind[i]);
+    if (!s.particle(i)) continue;
+    const int k = static_cast<int>(s.kind(i));
     ++count[k];
-    EXPECT_DOUBLE_EQ(s.stiffness[i], constant_of(lat.particle_springs, s.kind[i]));
+    EXPECT_DOUBLE_EQ(s.stiffness(i), constant_of(lat.particle_springs, s.kind(i)));
     const auto a = lat.shape.node_coordinates(s.first[i]);
     const auto b = lat.shape.node_coordinates(s.second[i]);
     // Cells containing the spring: lower corner from min(a, b) along spanned axes, both
@@ -265,8 +266,8 @@ TEST(LatticeSprings, ParticleRulesDifferOnlyBetweenNeighbouringParticles) {
   const Lattice seed = build_lattice(spec);
   std::int64_t phys_particle = 0, seed_particle = 0, cross = 0;
   for (std::size_t i = 0; i < phys.springs.size(); ++i) {
-    phys_particle += phys.springs.particle[i];
-    seed_particle += seed.springs.particle[i];
+    phys_particle += phys.springs.particle(i);
+    seed_particle += seed.springs.particle(i);
     const auto pa = seed.particle_of_node[seed.springs.first[i]];
     const auto pb = seed.particle_of_node[seed.springs.second[i]];
     if (pa >= 0 && pb >= 0 && pa != pb) ++cross;
@@ -276,35 +277,49 @@ TEST(LatticeSprings, ParticleRulesDifferOnlyBetweenNeighbouringParticles) {
   EXPECT_EQ(seed_particle, phys_particle + cross);
 }
 
-// The one-byte stiffness table gives back every pushed value bit for bit, shares equal values,
-// and refuses a 257th distinct value; a lattice with a particle needs at most 15 values.
-TEST(LatticeSprings, StiffnessTableKeepsEveryValueExactly) {
-  SpringStiffness table;
-  std::vector<double> pushed;
+// The one-byte property table gives back every pushed entry bit for bit, shares equal entries,
+// and refuses a 257th distinct one; a lattice with a particle needs at most 15 entries.
+TEST(LatticeSprings, PropertyTableKeepsEveryValueExactly) {
+  SpringProperties table;
+  std::vector<SpringProperties::Entry> pushed;
   for (int i = 0; i < 256; ++i) {
-    const double k = std::nextafter(1.0 + i / 7.0, 2.0);  // not exactly representable sums
-    table.push_back(k);
-    table.push_back(k);
-    pushed.push_back(k);
-    pushed.push_back(k);
+    const double k = std::nextafter(1.0 + (i / 2) / 7.0, 2.0);  // not exactly representable sums
+    // The same stiffness with two kinds or particle flags: distinct entries.
+    const SpringProperties::Entry e{k, i % 2 == 0 ? SpringKind::face : SpringKind::body, i % 4 < 2};
+    table.push_back(e);
+    table.push_back(e);
+    pushed.push_back(e);
+    pushed.push_back(e);
   }
   ASSERT_EQ(table.size(), pushed.size());
-  for (std::size_t s = 0; s < pushed.size(); ++s) EXPECT_EQ(table[s], pushed[s]) << s;
-  EXPECT_EQ(table.distinct_values().size(), 256u);
-  EXPECT_THROW(table.push_back(3.5), std::length_error);
-  table.push_back(pushed[5]);  // a known value still fits
+  for (std::size_t s = 0; s < pushed.size(); ++s) {
+    EXPECT_EQ(table[s].stiffness, pushed[s].stiffness) << s;
+    EXPECT_EQ(table[s].kind, pushed[s].kind) << s;
+    EXPECT_EQ(table[s].particle, pushed[s].particle) << s;
+  }
+  EXPECT_EQ(table.table().size(), 256u);
+  EXPECT_THROW(table.push_back({3.5, SpringKind::edge, false}), std::length_error);
+  table.push_back(pushed[5]);  // a known entry still fits
   EXPECT_EQ(table[table.size() - 1], pushed[5]);
 
   LatticeSpec spec;
   spec.placement = ByHandPlacement{{Eigen::Vector3d(5e-6, 5e-6, 5e-6)},
                                    {Eigen::Vector3d(2.5e-6, 2.5e-6, 2.5e-6)}};
   const Lattice lat = build_lattice(spec);
-  const std::vector<double>& distinct = lat.springs.stiffness.distinct_values();
+  const std::vector<SpringProperties::Entry>& distinct = lat.springs.properties.table();
   EXPECT_LE(distinct.size(), 15u);
-  std::set<double> seen;
-  for (std::size_t i = 0; i < lat.springs.size(); ++i) seen.insert(lat.springs.stiffness[i]);
-  EXPECT_EQ(seen, std::set<double>(distinct.begin(), distinct.end()));
-  EXPECT_EQ(seen.size(), distinct.size());  // each value once in the table
+  std::set<std::tuple<double, int, bool>> seen;
+  bool any_particle = false;
+  for (std::size_t i = 0; i < lat.springs.size(); ++i) {
+    seen.insert(
+        {lat.springs.stiffness(i), static_cast<int>(lat.springs.kind(i)), lat.springs.particle(i)});
+    any_particle = any_particle || lat.springs.particle(i);
+  }
+  std::set<std::tuple<double, int, bool>> listed;
+  for (const auto& e : distinct) listed.insert({e.stiffness, static_cast<int>(e.kind), e.particle});
+  EXPECT_EQ(seen, listed);
+  EXPECT_EQ(seen.size(), distinct.size());  // each entry once in the table
+  EXPECT_TRUE(any_particle);
 }
 
 }  // namespace

@@ -33,6 +33,28 @@ TEST(LatticeVolumeElements, VertexOrderOfTheOriginal) {
   EXPECT_EQ(elements[shape.cell_index(1, 2, 3)][6], shape.node_index(2, 3, 3));
 }
 
+// The cells computed from the grid are the stored array's, cell by cell, through indexing,
+// iteration and cell_at(corner), on boxes with 2 nodes along an axis and on uneven ones.
+TEST(LatticeVolumeElements, GridCellsAreTheStoredCells) {
+  for (const GridShape shape :
+       {GridShape{{2, 2, 2}}, GridShape{{3, 4, 5}}, GridShape{{7, 2, 3}}, GridShape{{4, 6, 2}}}) {
+    const auto stored = build_elements(shape);
+    const GridCells cells(shape);
+    ASSERT_EQ(cells.size(), stored.size());
+    std::size_t c = 0;
+    for (const auto& cell : cells) {
+      ASSERT_LT(c, stored.size());
+      EXPECT_EQ(cell, stored[c]) << "cell " << c;
+      EXPECT_EQ(cells[c], stored[c]) << "cell " << c;
+      EXPECT_EQ(cells.corner(static_cast<std::int64_t>(c)), stored[c][0]) << "cell " << c;
+      EXPECT_EQ(cells.cell_at(stored[c][0]), stored[c]) << "cell " << c;
+      ++c;
+    }
+    EXPECT_EQ(c, stored.size());
+  }
+  EXPECT_TRUE(GridCells().empty());
+}
+
 TEST(LatticeVolumeElements, VolumeOfUndeformedAndAffineCells) {
   const double l = 0.3;
   EXPECT_NEAR(cell_volume(unit_cube(l)), l * l * l, 1e-15);

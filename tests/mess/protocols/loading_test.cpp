@@ -541,10 +541,7 @@ TensionResult free_tension(const lat::Lattice& l, int normal, double eps) {
   mess::MessSystem sys =
       mess::MessSystem::make(l, Eigen::Vector3d::Zero(), mess::model_profile("physical"));
   mess::BoundaryConstraints c = mess::BoundaryConstraints::none(l.node_count());
-  const auto hold = [&](int node, int axis, double value) {
-    c.fixed[3 * static_cast<std::size_t>(node) + axis] = 1;
-    c.prescribed(axis, node) = value;
-  };
+  const auto hold = [&](int node, int axis, double value) { c.hold(node, axis, value); };
   for (int n = 0; n < l.node_count(); ++n) {
     if (on_face(l.shape, n, normal, false)) hold(n, normal, 0.0);
     if (on_face(l.shape, n, normal, true)) hold(n, normal, l.positions(normal, n) * (1.0 + eps));

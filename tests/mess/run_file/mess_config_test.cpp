@@ -309,7 +309,7 @@ TEST(MessConfigSystems, Defaults) {
   EXPECT_EQ(lat.node_count(), s.geometry.node_count());
   EXPECT_EQ(static_cast<std::int64_t>(lat.springs.size()), s.geometry.springs.total());
   std::int64_t stiff = 0;
-  for (const auto p : lat.springs.particle) stiff += p;
+  for (std::size_t i = 0; i < lat.springs.size(); ++i) stiff += lat.springs.particle(i) ? 1 : 0;
   EXPECT_EQ(stiff, s.geometry.particle_springs.total());
   ASSERT_EQ(lat.particle_centres.size(), 2u);
   EXPECT_NEAR((lat.particle_centres[1] - s.geometry.particle_centres[1]).norm(), 0.0, 1e-18);

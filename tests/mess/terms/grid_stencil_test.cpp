@@ -74,7 +74,7 @@ void expect_kernel_matches_reference(const lat::Lattice& l) {
   reference_gather(l, expected, [&](std::size_t s) {
     const Eigen::Vector3d r = x.col(sp.second[s]) - x.col(sp.first[s]);
     const double length = r.norm();
-    const double tension = sp.stiffness[s] * (length - sp.rest_length(s)) / length;
+    const double tension = sp.stiffness(s) * (length - sp.rest_length(s)) / length;
     return Eigen::Vector3d(tension * r);
   });
   EXPECT_TRUE(gradient == expected)
@@ -90,7 +90,7 @@ void expect_kernel_matches_reference(const lat::Lattice& l) {
     const double ratio = sp.rest_length(s) / length;
     const Eigen::Vector3d u = r / length;
     const Eigen::Vector3d dv = v.col(sp.second[s]) - v.col(sp.first[s]);
-    return Eigen::Vector3d(sp.stiffness[s] * ((1.0 - ratio) * dv + (ratio * u.dot(dv)) * u));
+    return Eigen::Vector3d(sp.stiffness(s) * ((1.0 - ratio) * dv + (ratio * u.dot(dv)) * u));
   });
   EXPECT_TRUE(product == expected_product)
       << "largest difference " << (product - expected_product).cwiseAbs().maxCoeff();

@@ -83,7 +83,7 @@ DistributedElastic::DistributedElastic(const lattice::Lattice& lattice,
       throw std::invalid_argument("DistributedElastic: spring " + std::to_string(s) +
                                   " does not join forward neighbours");
     }
-    const double k = springs.stiffness[s];
+    const double k = springs.stiffness(s);
     auto known = std::find(stiffness_.begin(), stiffness_.end(), k);
     if (known == stiffness_.end()) {
       if (stiffness_.size() == kNoSpring) {

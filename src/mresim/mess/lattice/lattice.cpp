@@ -54,7 +54,7 @@ Lattice build_lattice(const LatticeSpec& spec) {
 
   lat.springs = build_springs(shape, l_e, lat.polymer.springs, lat.particle_springs,
                               lat.particle_of_node, spec.particle_spring_rule);
-  lat.elements = build_elements(shape);
+  lat.elements = GridCells(shape);
   lat.masses = nodal_masses(shape, l_e, lat.particle_nodes, spec.particle_radius,
                             spec.polymer_density, spec.iron_density);
   return lat;

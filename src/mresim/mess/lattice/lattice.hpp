@@ -14,6 +14,7 @@
 #include "mresim/mess/lattice/spheres.hpp"
 #include "mresim/mess/lattice/springs.hpp"
 #include "mresim/mess/lattice/stiffness.hpp"
+#include "mresim/mess/lattice/volume_elements.hpp"
 
 namespace mresim::lattice {
 
@@ -40,7 +41,7 @@ struct Lattice {
   Eigen::VectorXd masses;               // kg per node
 
   SpringSet springs;
-  std::vector<std::array<std::int32_t, 8>> elements;  // local vertex order of volume_elements
+  GridCells elements;  // the cells' nodes, local vertex order of volume_elements.hpp
 
   LatticeStiffness polymer;          // polymer spring constants and kappa (used in every cell)
   SpringConstants particle_springs;  // constants of particle springs

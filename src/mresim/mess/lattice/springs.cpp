@@ -61,14 +61,14 @@ int bulk_cells_containing(SpringKind kind) {
   return 1;
 }
 
-void SpringStiffness::push_back(double k) {
+void SpringProperties::push_back(const Entry& entry) {
   std::size_t v = 0;
-  while (v < values_.size() && values_[v] != k) ++v;
-  if (v == values_.size()) {
-    if (values_.size() == 256) {
-      throw std::length_error("SpringStiffness: more than 256 distinct spring stiffnesses");
+  while (v < table_.size() && !(table_[v] == entry)) ++v;
+  if (v == table_.size()) {
+    if (table_.size() == 256) {
+      throw std::length_error("SpringProperties: more than 256 distinct spring properties");
     }
-    values_.push_back(k);
+    table_.push_back(entry);
   }
   index_.push_back(static_cast<std::uint8_t>(v));
 }
@@ -87,9 +87,7 @@ SpringSet build_springs(const GridShape& shape, double element_length,
   const auto expected = static_cast<std::size_t>(closed_form_spring_counts(shape).total());
   set.first.reserve(expected);
   set.second.reserve(expected);
-  set.stiffness.reserve(expected);
-  set.kind.reserve(expected);
-  set.particle.reserve(expected);
+  set.properties.reserve(expected);
 
   // Bulk constants of the three kinds, and the same divided by the bulk cell counts.
   const std::array<double, 3> polymer_per_cell{polymer.edge / 4.0, polymer.face / 2.0,
@@ -121,11 +119,10 @@ SpringSet build_springs(const GridShape& shape, double element_length,
               pi >= 0 && pj >= 0 && (rule == ParticleSpringRule::any_particle || pi == pj);
           set.first.push_back(i);
           set.second.push_back(j);
-          set.kind.push_back(kinds[n]);
-          set.particle.push_back(is_particle ? 1 : 0);
-          set.stiffness.push_back(is_particle ? particle_k[k]
-                                              : polymer_per_cell[k] *
-                                                    cells_containing(shape, ix, iy, iz, d));
+          set.properties.push_back(
+              {is_particle ? particle_k[k]
+                           : polymer_per_cell[k] * cells_containing(shape, ix, iy, iz, d),
+               kinds[n], is_particle});
         }
       }
     }

@@ -58,21 +58,29 @@ enum class ParticleSpringRule {
   any_particle,   // both ends are particle nodes, of any particles (the original code)
 };
 
-// The springs' stiffnesses (N/m) as a one-byte index per spring into a table of the distinct
-// values: a lattice has at most 15 of them (three kinds, weighted by the 1-4 cells holding a
-// spring, and the particles' three constants), so this keeps 1 byte per spring instead of 8
-// (about 90 bytes per node) and gives back the same values bit for bit.
-class SpringStiffness {
+// Each spring's stiffness (N/m), kind and whether it got the particle constant, as a one-byte
+// index into a table of the lattice's distinct combinations: a lattice has at most 15 of them
+// (three kinds, weighted by the 1-4 cells holding a spring, and the particles' three
+// constants), so this keeps 1 byte per spring instead of 10 (about 115 bytes per node) and
+// gives back the same values bit for bit.
+class SpringProperties {
  public:
-  double operator[](std::size_t s) const { return values_[index_[s]]; }
+  struct Entry {
+    double stiffness = 0.0;  // N/m
+    SpringKind kind = SpringKind::edge;
+    bool particle = false;
+    bool operator==(const Entry&) const = default;
+  };
+
+  const Entry& operator[](std::size_t s) const { return table_[index_[s]]; }
   std::size_t size() const { return index_.size(); }
   void reserve(std::size_t n) { index_.reserve(n); }
-  // Appends a spring of stiffness k. Throws std::length_error past 256 distinct values.
-  void push_back(double k);
-  const std::vector<double>& distinct_values() const { return values_; }
+  // Appends a spring. Throws std::length_error past 256 distinct entries.
+  void push_back(const Entry& entry);
+  const std::vector<Entry>& table() const { return table_; }
 
  private:
-  std::vector<double> values_;
+  std::vector<Entry> table_;
   std::vector<std::uint8_t> index_;
 };
 
@@ -80,13 +88,15 @@ class SpringStiffness {
 struct SpringSet {
   std::vector<std::int32_t> first;
   std::vector<std::int32_t> second;
-  SpringStiffness stiffness;  // N/m
-  std::vector<SpringKind> kind;
-  std::vector<std::uint8_t> particle;  // 1 if it got the particle constant, else 0
-  double element_length = 0.0;         // m
+  SpringProperties properties;
+  double element_length = 0.0;  // m
 
   std::size_t size() const { return first.size(); }
-  double rest_length(std::size_t s) const { return element_length * rest_length_factor(kind[s]); }
+  double stiffness(std::size_t s) const { return properties[s].stiffness; }  // N/m
+  SpringKind kind(std::size_t s) const { return properties[s].kind; }
+  // True if the spring got the particle constant.
+  bool particle(std::size_t s) const { return properties[s].particle; }
+  double rest_length(std::size_t s) const { return element_length * rest_length_factor(kind(s)); }
 };
 
 // All springs of the box. particle_of_node[n] is the particle holding node n, or -1 (may be

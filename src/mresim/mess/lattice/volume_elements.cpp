@@ -24,6 +24,23 @@ std::vector<std::array<std::int32_t, 8>> build_elements(const GridShape& shape) 
   return elements;
 }
 
+GridCells::GridCells(const GridShape& shape) : shape_(shape), count_(shape.cell_count()) {
+  validate_grid_shape(shape);
+  for (int v = 0; v < 8; ++v) {
+    const auto o = vertex_offset(v);
+    step_[static_cast<std::size_t>(v)] = shape.node_index(o[0], o[1], o[2]);
+  }
+}
+
+std::int64_t GridCells::corner(std::int64_t c) const {
+  const auto cells = shape_.cells();
+  const std::int64_t cx = c % cells[0];
+  const std::int64_t rest = c / cells[0];
+  const std::int64_t cy = rest % cells[1];
+  const std::int64_t cz = rest / cells[1];
+  return cz + std::int64_t{shape_.nz()} * (cx + std::int64_t{shape_.nx()} * cy);
+}
+
 EdgeVectors averaged_edge_vectors(const CellVertices& x) {
   EdgeVectors e;
   e.a = 0.25 * (x[2] - x[0] + x[3] - x[1] + x[6] - x[4] + x[7] - x[5]);  // eq. 4.45

@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -27,8 +28,61 @@ namespace mresim::lattice {
 inline std::array<int, 3> vertex_offset(int v) { return {(v >> 1) & 1, (v >> 2) & 1, v & 1}; }
 
 // The 8 node indices of every cell, cells in cell-index order (x fastest), vertices in the
-// local order above.
+// local order above, as an array (the reference GridCells is checked against).
 std::vector<std::array<std::int32_t, 8>> build_elements(const GridShape& shape);
+
+// The same cells computed from the grid when asked for, instead of stored: 8 indices per cell
+// would take 32 bytes per node. A random-access range of std::array<std::int32_t, 8>
+// (by value): cells[c], cells.size(), and range-for. Vertex v of the cell with lower corner
+// node n0 is n0 + vertex_step(v).
+class GridCells {
+ public:
+  using Cell = std::array<std::int32_t, 8>;
+
+  GridCells() = default;
+  explicit GridCells(const GridShape& shape);
+
+  std::size_t size() const { return static_cast<std::size_t>(count_); }
+  bool empty() const { return count_ == 0; }
+  // The lower corner node (local vertex 0) of cell c.
+  std::int64_t corner(std::int64_t c) const;
+  // Node index step from a cell's vertex 0 to its vertex v.
+  std::int64_t vertex_step(int v) const { return step_[static_cast<std::size_t>(v)]; }
+  Cell operator[](std::size_t c) const { return cell_at(static_cast<std::int64_t>(corner_of(c))); }
+  // The cell whose lower corner is node n0.
+  Cell cell_at(std::int64_t n0) const {
+    Cell e{};
+    for (std::size_t v = 0; v < 8; ++v) e[v] = static_cast<std::int32_t>(n0 + step_[v]);
+    return e;
+  }
+
+  class Iterator {
+   public:
+    using value_type = Cell;
+    using difference_type = std::ptrdiff_t;
+    Iterator(const GridCells* cells, std::size_t c) : cells_(cells), c_(c) {}
+    Cell operator*() const { return (*cells_)[c_]; }
+    Iterator& operator++() {
+      ++c_;
+      return *this;
+    }
+    bool operator==(const Iterator& other) const { return c_ == other.c_; }
+    bool operator!=(const Iterator& other) const { return c_ != other.c_; }
+
+   private:
+    const GridCells* cells_;
+    std::size_t c_;
+  };
+  Iterator begin() const { return {this, 0}; }
+  Iterator end() const { return {this, size()}; }
+
+ private:
+  std::int64_t corner_of(std::size_t c) const { return corner(static_cast<std::int64_t>(c)); }
+
+  GridShape shape_;
+  std::int64_t count_ = 0;
+  std::array<std::int64_t, 8> step_{};
+};
 
 using CellVertices = std::array<Eigen::Vector3d, 8>;
 

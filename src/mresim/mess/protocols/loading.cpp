@@ -94,11 +94,6 @@ void check_sign(const char* function, LoadKind kind, double value) {
   }
 }
 
-void hold(mess::BoundaryConstraints& c, int node, const Eigen::Vector3d& p) {
-  for (int a = 0; a < 3; ++a) c.fixed[3 * static_cast<std::size_t>(node) + a] = 1;
-  c.prescribed.col(node) = p;
-}
-
 // Nodes on any of the six faces, each once, in increasing index order.
 std::vector<int> surface_nodes(const lattice::GridShape& shape) {
   std::vector<int> out;
@@ -197,7 +192,7 @@ LoadState strain_load(const lattice::Lattice& lattice, const mess_config::Strain
   // strain_simple_shearing: the whole boundary on the affine field, at every value (0 too).
   if (strain.kind == LoadKind::shear && strain.boundary == mess_config::ShearBoundary::all_faces) {
     const double t = std::tan(value);
-    for (const int n : surface_nodes(shape)) hold(c, n, sheared(reference, n, normal, along, t));
+    for (const int n : surface_nodes(shape)) c.hold(n, sheared(reference, n, normal, along, t));
     return s;
   }
 
@@ -214,8 +209,8 @@ LoadState strain_load(const lattice::Lattice& lattice, const mess_config::Strain
   switch (strain.kind) {
     case LoadKind::shear: {  // strain_shearing: both normal faces on the affine field
       const double t = std::tan(value);
-      for (const int n : lower) hold(c, n, sheared(reference, n, normal, along, t));
-      for (const int n : upper) hold(c, n, sheared(reference, n, normal, along, t));
+      for (const int n : lower) c.hold(n, sheared(reference, n, normal, along, t));
+      for (const int n : upper) c.hold(n, sheared(reference, n, normal, along, t));
       break;
     }
     case LoadKind::tension:
@@ -224,7 +219,7 @@ LoadState strain_load(const lattice::Lattice& lattice, const mess_config::Strain
       for (const int n : upper) {
         Eigen::Vector3d p = reference.col(n);
         p[normal] *= 1.0 + value;
-        hold(c, n, p);
+        c.hold(n, p);
       }
       break;
     }
@@ -236,7 +231,7 @@ LoadState strain_load(const lattice::Lattice& lattice, const mess_config::Strain
       for (const int n : upper) {
         const Eigen::Vector3d p = reference.col(n);
         centre[normal] = p[normal];  // rotate within the face's own plane
-        hold(c, n, centre + rotation * (p - centre));
+        c.hold(n, centre + rotation * (p - centre));
       }
       break;
     }

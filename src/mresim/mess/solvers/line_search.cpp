@@ -5,6 +5,8 @@
 #include <limits>
 #include <utility>
 
+#include "mresim/mess/solvers/vector_algebra.hpp"
+
 namespace mresim::mess::detail {
 
 bool StallGuard::stalled(const Eigen::VectorXd& g, double change, const Objective& f,
@@ -26,8 +28,8 @@ bool StallGuard::stalled(const Eigen::VectorXd& g, double change, const Objectiv
 }
 
 bool wolfe_line_search(Objective& f, const Eigen::VectorXd& u, const Eigen::VectorXd& d,
-                       const LinePoint& from, double alpha_init, double alpha_max,
-                       bool use_energy, LinePoint& out) {
+                       const LinePoint& from, double alpha_init, double alpha_max, bool use_energy,
+                       LinePoint& out) {
   // At full size every gradient is 24 bytes per node, so the search keeps only the ones it may
   // return: not the start's (alpha = 0 is never accepted) nor the upper ends' of the zoom.
   LinePoint start;
@@ -43,7 +45,7 @@ bool wolfe_line_search(Objective& f, const Eigen::VectorXd& u, const Eigen::Vect
     LinePoint p;
     p.alpha = alpha;
     p.phi = f.along(u, alpha, d, p.g);
-    p.dphi = p.g.dot(d);
+    p.dphi = parallel_dot(p.g, d);
     return p;
   };
   const auto armijo_fails = [&](const LinePoint& p) {

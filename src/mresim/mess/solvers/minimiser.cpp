@@ -14,6 +14,7 @@
 #include "mresim/mess/solvers/newton.hpp"
 #include "mresim/mess/solvers/preconditioner.hpp"
 #include "mresim/mess/solvers/relaxation_common.hpp"
+#include "mresim/mess/solvers/vector_algebra.hpp"
 
 namespace mresim::mess {
 
@@ -115,10 +116,18 @@ class LbfgsMemory {
   // oldest beyond `size`.
   void add(double alpha, const Eigen::VectorXd& d, const Eigen::VectorXd& g_new,
            const Eigen::VectorXd& g_old, int size) {
-    const auto s = alpha * d;
-    const auto y = g_new - g_old;
-    const double sy = s.dot(y);
-    if (!(sy > 1e-12 * y.squaredNorm() && sy > 0.0)) return;
+    const Eigen::Index n = d.size();
+    const auto s_of = [&](Eigen::Index begin, Eigen::Index length) {
+      return alpha * d.segment(begin, length);
+    };
+    const auto y_of = [&](Eigen::Index begin, Eigen::Index length) {
+      return g_new.segment(begin, length) - g_old.segment(begin, length);
+    };
+    const double sy = detail::sum_over_blocks(
+        n, [&](Eigen::Index b, Eigen::Index l) { return s_of(b, l).dot(y_of(b, l)); });
+    const double yy = detail::sum_over_blocks(
+        n, [&](Eigen::Index b, Eigen::Index l) { return y_of(b, l).squaredNorm(); });
+    if (!(sy > 1e-12 * yy && sy > 0.0)) return;
     Eigen::VectorXd s_store;
     Eigen::VectorXd y_store;
     if (static_cast<int>(S_.size()) >= size) {
@@ -128,8 +137,13 @@ class LbfgsMemory {
       Y_.pop_front();
       rho_.pop_front();
     }
-    s_store = s;
-    y_store = y;
+    s_store.resize(n);
+    y_store.resize(n);
+    (void)detail::sum_over_blocks(n, [&](Eigen::Index b, Eigen::Index l) {
+      s_store.segment(b, l) = s_of(b, l);
+      y_store.segment(b, l) = y_of(b, l);
+      return 0.0;
+    });
     S_.push_back(std::move(s_store));
     Y_.push_back(std::move(y_store));
     rho_.push_back(1.0 / sy);
@@ -142,26 +156,46 @@ class LbfgsMemory {
   }
 
   // H g by the two-loop recursion (N&W Alg. 7.4), H0 = (s.y / y.P y) P with the newest pair.
+  // It sweeps the 2m stored vectors on both cores (vector_algebra.hpp: fixed blocks, so the
+  // result does not depend on the thread count), each update fused with the next dot product:
+  // 2m + 1 sweeps over q instead of 4m.
   Eigen::VectorXd times(const Eigen::VectorXd& g, const Preconditioner& P) {
+    using detail::parallel_axpy;
+    using detail::parallel_axpy_dot;
+    using detail::parallel_dot;
     Eigen::VectorXd q = g;
-    std::vector<double> a(S_.size());
-    for (int i = static_cast<int>(S_.size()) - 1; i >= 0; --i) {
-      const auto k = static_cast<std::size_t>(i);
-      a[k] = rho_[k] * S_[k].dot(q);
-      q -= a[k] * Y_[k];
+    const int m = static_cast<int>(S_.size());
+    const auto at = [](int k) { return static_cast<std::size_t>(k); };
+    std::vector<double> a(at(m));
+    // Newest to oldest: a_k = rho_k s_k.q, q -= a_k y_k.
+    double sq = m > 0 ? parallel_dot(S_[at(m - 1)], q) : 0.0;
+    for (int k = m - 1; k >= 0; --k) {
+      a[at(k)] = rho_[at(k)] * sq;
+      if (k > 0) {
+        sq = parallel_axpy_dot(-a[at(k)], Y_[at(k)], q, S_[at(k - 1)]);
+      } else {
+        parallel_axpy(-a[at(k)], Y_[at(k)], q);
+      }
     }
-    if (!S_.empty()) {
+    if (m > 0) {
       if (!scale_known_) {  // one preconditioner application per new pair, not per call
-        scale_ = S_.back().dot(Y_.back()) / Y_.back().dot(P(Y_.back()));
+        scale_ = parallel_dot(S_.back(), Y_.back()) / parallel_dot(Y_.back(), P(Y_.back()));
         scale_known_ = true;
       }
-      q = P(q) * scale_;
+      q = P(q);
+      detail::parallel_scale(scale_, q);
     } else {
       q = P(q);
     }
-    for (std::size_t k = 0; k < S_.size(); ++k) {
-      const double b = rho_[k] * Y_[k].dot(q);
-      q += (a[k] - b) * S_[k];
+    // Oldest to newest: b_k = rho_k y_k.q, q += (a_k - b_k) s_k.
+    double yq = m > 0 ? parallel_dot(Y_[0], q) : 0.0;
+    for (int k = 0; k < m; ++k) {
+      const double b = rho_[at(k)] * yq;
+      if (k + 1 < m) {
+        yq = parallel_axpy_dot(a[at(k)] - b, S_[at(k)], q, Y_[at(k + 1)]);
+      } else {
+        parallel_axpy(a[at(k)] - b, S_[at(k)], q);
+      }
     }
     return q;
   }
@@ -201,13 +235,13 @@ InnerResult run_lbfgs(Objective& f, Eigen::VectorXd& u, int budget, const Minimi
   while (r.iterations < budget) {
     Eigen::VectorXd d = memory.times(cur.g, P);
     d = -d;  // in place: no second vector
-    cur.dphi = cur.g.dot(d);
+    cur.dphi = detail::parallel_dot(cur.g, d);
     if (!(cur.dphi < 0.0)) {  // not a descent direction: restart from steepest descent
       memory.clear();
       d = -P(cur.g);
-      cur.dphi = cur.g.dot(d);
+      cur.dphi = detail::parallel_dot(cur.g, d);
     }
-    const double dmax = d.cwiseAbs().maxCoeff();
+    const double dmax = detail::parallel_max_abs(d);
     const double alpha_max = opt.max_step / dmax;
     // Without curvature information (no memory, no preconditioner) the first step is limited
     // to a tenth of max_step.
@@ -225,7 +259,7 @@ InnerResult run_lbfgs(Objective& f, Eigen::VectorXd& u, int budget, const Minimi
       continue;
     }
     failures = 0;
-    u += next.alpha * d;
+    detail::parallel_axpy(next.alpha, d, u);
     r.energy_change = next.phi - cur.phi;
     memory.add(next.alpha, d, next.g, cur.g, opt.lbfgs_memory);
     cur = std::move(next);

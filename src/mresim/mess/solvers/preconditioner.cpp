@@ -16,7 +16,7 @@ RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& syste
   const lattice::SpringSet& sp = lat.springs;
   for (std::size_t s = 0; s < sp.size(); ++s) {
     const Eigen::Vector3d e = (x0.col(sp.second[s]) - x0.col(sp.first[s])).normalized();
-    const Eigen::Vector3d h = sp.stiffness[s] * e.cwiseAbs2();
+    const Eigen::Vector3d h = sp.stiffness(s) * e.cwiseAbs2();
     d.col(sp.first[s]) += h;
     d.col(sp.second[s]) += h;
   }

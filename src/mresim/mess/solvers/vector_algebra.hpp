@@ -11,10 +11,7 @@
 // fused form does an update and the next dot product in one sweep, which saves one pass over
 // memory.
 //
-// L-BFGS's two-loop recursion (minimiser.cpp) still uses Eigen's serial algebra: with these
-// dot products (other rounding) its path changed enough that the scaled-down Fig. 4.11
-// example's snap into contact, which converges in about 2,000 iterations, hit the iteration
-// limit (its force tolerance lies near the rounding floor of that problem; docs/performance.md).
+// L-BFGS (minimiser.cpp) uses them too: its two-loop recursion and the pair updates.
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -55,6 +52,14 @@ inline double parallel_dot(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
 inline void parallel_axpy(double alpha, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
   (void)sum_over_blocks(y.size(), [&](Eigen::Index begin, Eigen::Index length) {
     y.segment(begin, length) += alpha * x.segment(begin, length);
+    return 0.0;
+  });
+}
+
+// y *= alpha
+inline void parallel_scale(double alpha, Eigen::VectorXd& y) {
+  (void)sum_over_blocks(y.size(), [&](Eigen::Index begin, Eigen::Index length) {
+    y.segment(begin, length) *= alpha;
     return 0.0;
   });
 }

@@ -11,20 +11,40 @@ namespace mresim::mess {
 BoundaryConstraints BoundaryConstraints::none(std::int64_t node_count) {
   BoundaryConstraints c;
   c.fixed.assign(static_cast<std::size_t>(3 * node_count), 0);
-  c.prescribed = Eigen::Matrix3Xd::Zero(3, node_count);
   return c;
+}
+
+void BoundaryConstraints::hold(std::int64_t node, int axis, double value) {
+  const auto n = static_cast<std::size_t>(node);
+  if (node < 0 || 3 * n + 2 >= fixed.size() || axis < 0 || axis > 2) {
+    throw std::invalid_argument("BoundaryConstraints::hold: node " + std::to_string(node) +
+                                " axis " + std::to_string(axis) + " out of range (" +
+                                std::to_string(fixed.size() / 3) + " nodes)");
+  }
+  fixed[3 * n + static_cast<std::size_t>(axis)] = 1;
+  auto [entry, added] =
+      prescribed_.try_emplace(static_cast<std::int32_t>(node), Eigen::Vector3d::Zero());
+  entry->second[axis] = value;
+}
+
+void BoundaryConstraints::hold(std::int64_t node, const Eigen::Vector3d& position) {
+  for (int a = 0; a < 3; ++a) hold(node, a, position[a]);
+}
+
+double BoundaryConstraints::prescribed(int axis, std::int64_t node) const {
+  const auto entry = prescribed_.find(static_cast<std::int32_t>(node));
+  return entry == prescribed_.end() ? 0.0 : entry->second[axis];
 }
 
 void BoundaryConstraints::fix_nodes(const std::vector<int>& nodes,
                                     const Eigen::Matrix3Xd& positions) {
   if (fixed.empty()) *this = none(positions.cols());
   for (const int n : nodes) {
-    if (n < 0 || n >= prescribed.cols()) {
+    if (n < 0 || n >= positions.cols()) {
       throw std::invalid_argument("BoundaryConstraints::fix_nodes: node " + std::to_string(n) +
                                   " out of range");
     }
-    for (int a = 0; a < 3; ++a) fixed[3 * static_cast<std::size_t>(n) + a] = 1;
-    prescribed.col(n) = positions.col(n);
+    hold(n, Eigen::Vector3d(positions.col(n)));
   }
 }
 
@@ -41,8 +61,11 @@ void BoundaryConstraints::validate(std::int64_t node_count) const {
   if (!fixed.empty() && static_cast<std::int64_t>(fixed.size()) != 3 * node_count) {
     throw std::invalid_argument("BoundaryConstraints: 'fixed' must have 3 entries per node");
   }
-  if (!fixed.empty() && prescribed.cols() != node_count) {
-    throw std::invalid_argument("BoundaryConstraints: 'prescribed' must have one column per node");
+  for (const auto& [node, value] : prescribed_) {
+    if (node >= node_count) {
+      throw std::invalid_argument("BoundaryConstraints: held node " + std::to_string(node) +
+                                  " out of range (" + std::to_string(node_count) + " nodes)");
+    }
   }
   std::vector<std::uint8_t> in_group(static_cast<std::size_t>(node_count), 0);
   for (std::size_t g = 0; g < rigid_groups.size(); ++g) {

@@ -5,8 +5,7 @@
 //
 // Two kinds of constraint, enough for every boundary condition of the original code:
 //  - fixed coordinates: coordinate a of node n is held at prescribed(a, n) (fixed surfaces,
-//    displaced surfaces of strain runs: the caller writes the displaced positions into
-//    `prescribed`);
+//    displaced surfaces of strain runs: the caller holds them at the displaced positions);
 //  - rigid groups: the nodes of a group move together by one common translation (all three
 //    components), e.g. the loaded face of tension/compression/shear runs at zero strain, which
 //    floats as a rigid body in the original. Group nodes must not have fixed coordinates.
@@ -14,6 +13,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 #include "mresim/mess/lattice/grid.hpp"
@@ -27,8 +27,6 @@ struct RigidGroup {
 struct BoundaryConstraints {
   // fixed[3 n + a] != 0: coordinate a (0 = x, 1 = y, 2 = z) of node n is held. Empty = none.
   std::vector<std::uint8_t> fixed;
-  // Values of the held coordinates (m), 3 x N; only the held entries are used.
-  Eigen::Matrix3Xd prescribed;
   std::vector<RigidGroup> rigid_groups;
 
   // No constraints for N nodes.
@@ -37,6 +35,12 @@ struct BoundaryConstraints {
   bool is_fixed(std::int64_t node, int axis) const {
     return !fixed.empty() && fixed[static_cast<std::size_t>(3 * node + axis)] != 0;
   }
+  // Holds coordinate `axis` of `node` at `value` (m), or all three at `position`. `fixed` must
+  // have its 3 N entries (none()).
+  void hold(std::int64_t node, int axis, double value);
+  void hold(std::int64_t node, const Eigen::Vector3d& position);
+  // The value a held coordinate is held at (m); 0 for one that was marked in `fixed` only.
+  double prescribed(int axis, std::int64_t node) const;
   // Holds all three coordinates of `nodes` at `positions` (columns of those nodes).
   void fix_nodes(const std::vector<int>& nodes, const Eigen::Matrix3Xd& positions);
   // Holds all three coordinates of the nodes of one face of the box at `positions`.
@@ -50,6 +54,11 @@ struct BoundaryConstraints {
 
   // Writes the held coordinates into x.
   void apply(Eigen::Matrix3Xd& x) const;
+
+ private:
+  // The held nodes' values, by node: held coordinates lie on the box's faces, so a map keeps
+  // them in a few bytes per node of the box instead of a 3 x N array (24 bytes per node).
+  std::unordered_map<std::int32_t, Eigen::Vector3d> prescribed_;
 };
 
 // Free variables in units of a length scale (l_e): every free coordinate of a node outside the

@@ -32,7 +32,7 @@ double spring_energy(const lattice::SpringSet& springs, const Eigen::Matrix3Xd& 
   for (std::size_t s = 0; s < springs.size(); ++s) {
     const double stretch =
         (x.col(springs.second[s]) - x.col(springs.first[s])).norm() - springs.rest_length(s);
-    energy += 0.5 * springs.stiffness[s] * stretch * stretch;  // eq. 4.62
+    energy += 0.5 * springs.stiffness(s) * stretch * stretch;  // eq. 4.62
   }
   return energy;
 }
@@ -43,14 +43,14 @@ void add_spring_gradient(const lattice::SpringSet& springs, const Eigen::Matrix3
     const Eigen::Vector3d r = x.col(springs.second[s]) - x.col(springs.first[s]);
     const double l = r.norm();
     // eq. 4.63: the force on the second end is -k (l - L) r^; the gradient is its negative.
-    const Eigen::Vector3d g = springs.stiffness[s] * (l - springs.rest_length(s)) / l * r;
+    const Eigen::Vector3d g = springs.stiffness(s) * (l - springs.rest_length(s)) / l * r;
     gradient.col(springs.second[s]) += g;
     gradient.col(springs.first[s]) -= g;
   }
 }
 
-double volume_energy(const std::vector<std::array<std::int32_t, 8>>& elements, double kappa,
-                     double element_length, const Eigen::Matrix3Xd& x) {
+double volume_energy(const lattice::GridCells& elements, double kappa, double element_length,
+                     const Eigen::Matrix3Xd& x) {
   const double v0 = element_length * element_length * element_length;
   double energy = 0.0;
   for (const auto& e : elements) {
@@ -60,9 +60,9 @@ double volume_energy(const std::vector<std::array<std::int32_t, 8>>& elements, d
   return energy;
 }
 
-void add_volume_gradient(const std::vector<std::array<std::int32_t, 8>>& elements, double kappa,
-                         double element_length, const Eigen::Matrix3Xd& x,
-                         Eigen::Matrix3Xd& gradient, double force_factor) {
+void add_volume_gradient(const lattice::GridCells& elements, double kappa, double element_length,
+                         const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& gradient,
+                         double force_factor) {
   const double v0 = element_length * element_length * element_length;
   lattice::CellVertices dv_dx;
   for (const auto& e : elements) {
@@ -156,7 +156,7 @@ Eigen::Matrix3d spring_block(const lattice::SpringSet& sp, std::size_t s,
   const double l = r.norm();
   const double ratio = sp.rest_length(s) / l;
   const Eigen::Vector3d u = r / l;
-  return sp.stiffness[s] *
+  return sp.stiffness(s) *
          ((1.0 - ratio) * Eigen::Matrix3d::Identity() + ratio * u * u.transpose());
 }
 
@@ -166,7 +166,8 @@ elastic::SpringValue spring_at(const lattice::SpringSet& sp,
                                std::int64_t s) {
   const auto u = static_cast<std::size_t>(s);
   const double l = (x.col(sp.second[u]) - x.col(sp.first[u])).norm();
-  return elastic::spring_value(sp.stiffness[u], rest_length[static_cast<std::size_t>(sp.kind[u])],
+  const lattice::SpringProperties::Entry& spring = sp.properties[u];  // one byte read
+  return elastic::spring_value(spring.stiffness, rest_length[static_cast<std::size_t>(spring.kind)],
                                l);
 }
 
@@ -316,11 +317,12 @@ void SpringKernel::add_hessian_product(const lattice::Lattice& lat, const Eigen:
     const auto i = static_cast<std::size_t>(s);
     const Eigen::Vector3d r = x.col(sp.second[i]) - x.col(sp.first[i]);
     const double l = r.norm();
-    const double ratio = rest_length[static_cast<std::size_t>(sp.kind[i])] / l;
+    const lattice::SpringProperties::Entry& spring = sp.properties[i];
+    const double ratio = rest_length[static_cast<std::size_t>(spring.kind)] / l;
     const Eigen::Vector3d u = r / l;
     const Eigen::Vector3d dv = v.col(sp.second[i]) - v.col(sp.first[i]);
     Eigen::Map<Eigen::Vector3d>(scratch_.data() + 3 * s) =
-        sp.stiffness[i] * ((1.0 - ratio) * dv + (ratio * u.dot(dv)) * u);
+        spring.stiffness * ((1.0 - ratio) * dv + (ratio * u.dot(dv)) * u);
   });
   stencil_.gather(out, [&](std::int64_t s, std::int64_t, std::int64_t) {
     return Eigen::Vector3d(Eigen::Map<const Eigen::Vector3d>(scratch_.data() + 3 * s));
@@ -460,11 +462,15 @@ ElasticValue VolumeKernel::evaluate_with_gradient(const lattice::Lattice& lat,
     };
     for (std::int64_t cz = layer_begin; cz < layer_end; ++cz) {
       double* t = buffers + 9 * (cz & 1) * layer;
-      for (std::int64_t c = cz * layer; c < (cz + 1) * layer; ++c, t += 9) {
-        const elastic::CellValue value =
-            elastic::cell_value(gather_vertices(lat.elements[static_cast<std::size_t>(c)], x),
-                                kappa, v0, force_factor, t);
-        sums.add(c, value.energy, value.rounding);
+      std::int64_t c = cz * layer;
+      for (int cy = 0; cy < ny - 1; ++cy) {
+        for (int cx = 0; cx < nx - 1; ++cx, ++c, t += 9) {
+          // The cell's nodes from the grid: its lower corner plus the vertex steps.
+          const std::int64_t corner = cz + std::int64_t{nz} * (cx + std::int64_t{nx} * cy);
+          const elastic::CellValue value = elastic::cell_value(
+              gather_vertices(lat.elements.cell_at(corner), x), kappa, v0, force_factor, t);
+          sums.add(c, value.energy, value.rounding);
+        }
       }
       if (cz >= plane_begin && cz < plane_end) gather_plane(cz);
     }

@@ -47,12 +47,12 @@ void add_spring_gradient(const lattice::SpringSet& springs, const Eigen::Matrix3
                          Eigen::Matrix3Xd& gradient);
 
 // Eq. 4.64 times V0 = l_e^3, summed over `elements` (kappa in Pa, l_e in m).
-double volume_energy(const std::vector<std::array<std::int32_t, 8>>& elements, double kappa,
-                     double element_length, const Eigen::Matrix3Xd& x);
+double volume_energy(const lattice::GridCells& elements, double kappa, double element_length,
+                     const Eigen::Matrix3Xd& x);
 // Adds force_factor times the exact gradient of volume_energy (eqs. 4.65-4.69 with the 1/4).
-void add_volume_gradient(const std::vector<std::array<std::int32_t, 8>>& elements, double kappa,
-                         double element_length, const Eigen::Matrix3Xd& x,
-                         Eigen::Matrix3Xd& gradient, double force_factor = 1.0);
+void add_volume_gradient(const lattice::GridCells& elements, double kappa, double element_length,
+                         const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& gradient,
+                         double force_factor = 1.0);
 
 // ------------------------------------------------ the parallel evaluator used by the solvers
 
