@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <deque>
 #include <functional>
 #include <limits>
 #include <memory>
 #include <random>
 #include <stdexcept>
 
+#include "mresim/mess/solvers/lbfgs_memory.hpp"
 #include "mresim/mess/solvers/leapfrog.hpp"
 #include "mresim/mess/solvers/line_search.hpp"
 #include "mresim/mess/solvers/newton.hpp"
@@ -88,125 +88,13 @@ namespace {
 
 using detail::ForceMeasure;
 using detail::InnerResult;
+using detail::LbfgsMemory;
 using detail::LinePoint;
 using detail::Objective;
 using detail::StallGuard;
 using detail::wolfe_line_search;
 
 // -------------------------------------------------------------------------------- L-BFGS
-
-// The L-BFGS memory: the last `size` steps s and gradient changes y, rho = 1/(s.y). A full
-// memory takes a new pair into the storage of the oldest one, so that it never holds more than
-// `size` pairs (at full size each vector is 24 bytes per node).
-class LbfgsMemory {
- public:
-  using Preconditioner = std::function<Eigen::VectorXd(const Eigen::VectorXd&)>;
-
-  bool empty() const { return S_.empty(); }
-  void clear() {
-    S_.clear();
-    Y_.clear();
-    rho_.clear();
-    scale_known_ = false;
-  }
-  // The preconditioner may have changed (a new inner run): H0's scale is computed again.
-  void forget_scale() { scale_known_ = false; }
-
-  // Keeps the pair s = alpha d, y = g_new - g_old if it has positive curvature, dropping the
-  // oldest beyond `size`.
-  void add(double alpha, const Eigen::VectorXd& d, const Eigen::VectorXd& g_new,
-           const Eigen::VectorXd& g_old, int size) {
-    const Eigen::Index n = d.size();
-    const auto s_of = [&](Eigen::Index begin, Eigen::Index length) {
-      return alpha * d.segment(begin, length);
-    };
-    const auto y_of = [&](Eigen::Index begin, Eigen::Index length) {
-      return g_new.segment(begin, length) - g_old.segment(begin, length);
-    };
-    const double sy = detail::sum_over_blocks(
-        n, [&](Eigen::Index b, Eigen::Index l) { return s_of(b, l).dot(y_of(b, l)); });
-    const double yy = detail::sum_over_blocks(
-        n, [&](Eigen::Index b, Eigen::Index l) { return y_of(b, l).squaredNorm(); });
-    if (!(sy > 1e-12 * yy && sy > 0.0)) return;
-    Eigen::VectorXd s_store;
-    Eigen::VectorXd y_store;
-    if (static_cast<int>(S_.size()) >= size) {
-      s_store = std::move(S_.front());
-      y_store = std::move(Y_.front());
-      S_.pop_front();
-      Y_.pop_front();
-      rho_.pop_front();
-    }
-    s_store.resize(n);
-    y_store.resize(n);
-    (void)detail::sum_over_blocks(n, [&](Eigen::Index b, Eigen::Index l) {
-      s_store.segment(b, l) = s_of(b, l);
-      y_store.segment(b, l) = y_of(b, l);
-      return 0.0;
-    });
-    S_.push_back(std::move(s_store));
-    Y_.push_back(std::move(y_store));
-    rho_.push_back(1.0 / sy);
-    while (static_cast<int>(S_.size()) > size) {  // a smaller size than before
-      S_.pop_front();
-      Y_.pop_front();
-      rho_.pop_front();
-    }
-    scale_known_ = false;
-  }
-
-  // H g by the two-loop recursion (N&W Alg. 7.4), H0 = (s.y / y.P y) P with the newest pair.
-  // It sweeps the 2m stored vectors on both cores (vector_algebra.hpp: fixed blocks, so the
-  // result does not depend on the thread count), each update fused with the next dot product:
-  // 2m + 1 sweeps over q instead of 4m.
-  Eigen::VectorXd times(const Eigen::VectorXd& g, const Preconditioner& P) {
-    using detail::parallel_axpy;
-    using detail::parallel_axpy_dot;
-    using detail::parallel_dot;
-    Eigen::VectorXd q = g;
-    const int m = static_cast<int>(S_.size());
-    const auto at = [](int k) { return static_cast<std::size_t>(k); };
-    std::vector<double> a(at(m));
-    // Newest to oldest: a_k = rho_k s_k.q, q -= a_k y_k.
-    double sq = m > 0 ? parallel_dot(S_[at(m - 1)], q) : 0.0;
-    for (int k = m - 1; k >= 0; --k) {
-      a[at(k)] = rho_[at(k)] * sq;
-      if (k > 0) {
-        sq = parallel_axpy_dot(-a[at(k)], Y_[at(k)], q, S_[at(k - 1)]);
-      } else {
-        parallel_axpy(-a[at(k)], Y_[at(k)], q);
-      }
-    }
-    if (m > 0) {
-      if (!scale_known_) {  // one preconditioner application per new pair, not per call
-        scale_ = parallel_dot(S_.back(), Y_.back()) / parallel_dot(Y_.back(), P(Y_.back()));
-        scale_known_ = true;
-      }
-      q = P(q);
-      detail::parallel_scale(scale_, q);
-    } else {
-      q = P(q);
-    }
-    // Oldest to newest: b_k = rho_k y_k.q, q += (a_k - b_k) s_k.
-    double yq = m > 0 ? parallel_dot(Y_[0], q) : 0.0;
-    for (int k = 0; k < m; ++k) {
-      const double b = rho_[at(k)] * yq;
-      if (k + 1 < m) {
-        yq = parallel_axpy_dot(a[at(k)] - b, S_[at(k)], q, Y_[at(k + 1)]);
-      } else {
-        parallel_axpy(a[at(k)] - b, S_[at(k)], q);
-      }
-    }
-    return q;
-  }
-
- private:
-  std::deque<Eigen::VectorXd> S_;
-  std::deque<Eigen::VectorXd> Y_;
-  std::deque<double> rho_;
-  double scale_ = 1.0;  // s.y / y.P y of the newest pair, once scale_known_
-  bool scale_known_ = false;
-};
 
 // `precondition`: P of H0 = gamma P (null: the identity). `memory`: the pairs to start from
 // (empty: a fresh start); it holds the run's pairs on return.

@@ -487,15 +487,25 @@ void VolumeKernel::add_hessian_product(const lattice::Lattice& lat, const Eigen:
   const auto cells = static_cast<std::int64_t>(lat.elements.size());
   const double v0 = std::pow(lat.element_length, 3);
   scratch_.resize(static_cast<std::size_t>(9 * cells));
-  for_each_item(cells, [&](std::int64_t c) {
-    const auto& element = lat.elements[static_cast<std::size_t>(c)];
-    const std::array<Eigen::Vector3d, 3> t =
-        cell_hessian_terms(lattice::averaged_edge_vectors(gather_vertices(element, x)),
-                           lattice::averaged_edge_vectors(gather_vertices(element, v)),
-                           lat.polymer.kappa, v0, force_factor);
-    for (int k = 0; k < 3; ++k)
-      Eigen::Map<Eigen::Vector3d>(scratch_.data() + 9 * c + 3 * std::int64_t{k}) = t[k];
-  });
+  // Row by row along x, so that each cell's nodes come from its row's first corner without a
+  // division per cell (the scratch entries do not depend on the loop's order).
+  const std::int64_t row_length = lat.shape.nx() - 1;
+  const std::int64_t rows = row_length > 0 ? cells / row_length : 0;
+  const std::int64_t corner_step = lat.shape.nz();
+#pragma omp parallel for schedule(static) if (cells >= detail::kParallelMinimum)
+  for (std::int64_t row = 0; row < rows; ++row) {
+    std::int64_t corner = lat.elements.corner(row * row_length);
+    for (std::int64_t c = row * row_length; c < (row + 1) * row_length;
+         ++c, corner += corner_step) {
+      const lattice::GridCells::Cell element = lat.elements.cell_at(corner);
+      const std::array<Eigen::Vector3d, 3> t =
+          cell_hessian_terms(lattice::averaged_edge_vectors(gather_vertices(element, x)),
+                             lattice::averaged_edge_vectors(gather_vertices(element, v)),
+                             lat.polymer.kappa, v0, force_factor);
+      for (int k = 0; k < 3; ++k)
+        Eigen::Map<Eigen::Vector3d>(scratch_.data() + 9 * c + 3 * std::int64_t{k}) = t[k];
+    }
+  }
   gather(scratch_, out);
 }
 
