@@ -16,8 +16,9 @@
 // five, with the same thread count. The bytes per node count every array the two elastic
 // kernels sweep once per evaluation (elastic_terms.cpp), with the lattice's own spring and cell
 // counts:
-//   springs, per spring: first + second + the property byte (stiffness, kind; 9 B); the
-//     tensions stay in a ring per thread that fits the cache (not counted);
+//   springs, per spring: the first node + the property byte (stiffness, kind, the step to the
+//     second node; 5 B); the tensions stay in a ring per thread that fits the cache (not
+//     counted);
 //   volume: nothing per cell (its nodes come from the grid, lattice::GridCells); the cells'
 //     coefficients stay in two layer buffers per thread (not counted);
 //   per node, each kernel: the positions read twice (48 B), the gradient read and written
@@ -95,7 +96,7 @@ double triad_bandwidth(int threads) {
 double elastic_bytes_per_node(const mresim::lattice::Lattice& lattice) {
   const auto nodes = static_cast<double>(lattice.node_count());
   const auto springs = static_cast<double>(lattice.springs.size());
-  const double per_spring = 9.0;
+  const double per_spring = 5.0;
   const double per_node_per_kernel = 48.0 + 48.0;
   const double spring_stencil = 10.0;
   return per_spring * springs / nodes + 2.0 * per_node_per_kernel + spring_stencil;

@@ -42,7 +42,7 @@ inline double lattice_energy_density(const Lattice& lat, const Eigen::Matrix3d& 
   double energy = 0.0;
   const SpringSet& s = lat.springs;
   for (std::size_t i = 0; i < s.size(); ++i) {
-    const double stretch = (x.col(s.second[i]) - x.col(s.first[i])).norm() - s.rest_length(i);
+    const double stretch = (x.col(s.second(i)) - x.col(s.first[i])).norm() - s.rest_length(i);
     energy += 0.5 * s.stiffness(i) * stretch * stretch;
   }
   const double v0 = std::pow(lat.element_length, 3);

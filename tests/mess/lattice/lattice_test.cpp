@@ -126,9 +126,9 @@ double smallest_elastic_eigenvalue(const Lattice& lat) {
   Eigen::MatrixXd h = Eigen::MatrixXd::Zero(dof, dof);
   const SpringSet& s = lat.springs;
   for (std::size_t i = 0; i < s.size(); ++i) {
-    const Eigen::Vector3d d = lat.positions.col(s.second[i]) - lat.positions.col(s.first[i]);
+    const Eigen::Vector3d d = lat.positions.col(s.second(i)) - lat.positions.col(s.first[i]);
     const Eigen::Matrix3d b = s.stiffness(i) * d * d.transpose() / d.squaredNorm();
-    const int a = 3 * s.first[i], c = 3 * s.second[i];
+    const int a = 3 * s.first[i], c = 3 * s.second(i);
     h.block<3, 3>(a, a) += b;
     h.block<3, 3>(c, c) += b;
     h.block<3, 3>(a, c) -= b;

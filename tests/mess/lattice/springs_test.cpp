@@ -83,7 +83,7 @@ TEST(LatticeSprings, CountsMatchClosedForms) {
     EXPECT_EQ(t.full[1], c.face.full);
     EXPECT_EQ(t.full[2], c.body.full);
     EXPECT_EQ(static_cast<std::int64_t>(s.size()), c.total());
-    for (std::size_t i = 0; i < s.size(); ++i) ASSERT_LT(s.first[i], s.second[i]);
+    for (std::size_t i = 0; i < s.size(); ++i) ASSERT_LT(s.first[i], s.second(i));
     // Every cell holds exactly 12 x 1/4 edge, 12 x 1/2 face and 4 body springs' worth.
     double sum[3] = {0, 0, 0};
     for (std::size_t i = 0; i < s.size(); ++i) sum[static_cast<int>(s.kind(i))] += s.stiffness(i);
@@ -103,7 +103,7 @@ TEST(LatticeSprings, OrderOfTheOriginal) {
   const int expected[] = {1, 3, 9, 10, 4, 12, 13};
   for (int i = 0; i < 7; ++i) {
     EXPECT_EQ(s.first[i], 0);
-    EXPECT_EQ(s.second[i], expected[i]);
+    EXPECT_EQ(s.second(i), expected[i]);
   }
   EXPECT_EQ(s.stiffness(0), kPolymer.edge / 4);  // corner: along an edge line
   EXPECT_EQ(s.stiffness(3), kPolymer.face / 2);  // in the left face
@@ -151,7 +151,7 @@ TEST(LatticeSprings, CellCountWeightingEqualsTheOriginalsNodeTypeRules) {
     const auto codes = node_type_codes(shape);
     for (std::size_t i = 0; i < s.size(); ++i) {
       const double w = seed_weight(s.kind(i), planes_of(codes[s.first[i]], shape, s.first[i]),
-                                   planes_of(codes[s.second[i]], shape, s.second[i]));
+                                   planes_of(codes[s.second(i)], shape, s.second(i)));
       ASSERT_DOUBLE_EQ(s.stiffness(i), w * constant_of(kPolymer, s.kind(i)))
           << "spring " << i << " of " << shape.nx() << "x" << shape.ny() << "x" << shape.nz();
     }
@@ -219,7 +219,7 @@ TEST(LatticeSprings, SpringsOfOneParticle) {
     ++count[k];
     EXPECT_DOUBLE_EQ(s.stiffness(i), constant_of(lat.particle_springs, s.kind(i)));
     const auto a = lat.shape.node_coordinates(s.first[i]);
-    const auto b = lat.shape.node_coordinates(s.second[i]);
+    const auto b = lat.shape.node_coordinates(s.second(i));
     // Cells containing the spring: lower corner from min(a, b) along spanned axes, both
     // layers along the others.
     bool any_particle_cell = false;
@@ -269,7 +269,7 @@ TEST(LatticeSprings, ParticleRulesDifferOnlyBetweenNeighbouringParticles) {
     phys_particle += phys.springs.particle(i);
     seed_particle += seed.springs.particle(i);
     const auto pa = seed.particle_of_node[seed.springs.first[i]];
-    const auto pb = seed.particle_of_node[seed.springs.second[i]];
+    const auto pb = seed.particle_of_node[seed.springs.second(i)];
     if (pa >= 0 && pb >= 0 && pa != pb) ++cross;
   }
   EXPECT_EQ(phys_particle, 2 * (2832 + 5328 + 3412));
@@ -278,14 +278,15 @@ TEST(LatticeSprings, ParticleRulesDifferOnlyBetweenNeighbouringParticles) {
 }
 
 // The one-byte property table gives back every pushed entry bit for bit, shares equal entries,
-// and refuses a 257th distinct one; a lattice with a particle needs at most 15 entries.
+// and refuses a 257th distinct one; a lattice with a particle needs at most 38 entries.
 TEST(LatticeSprings, PropertyTableKeepsEveryValueExactly) {
   SpringProperties table;
   std::vector<SpringProperties::Entry> pushed;
   for (int i = 0; i < 256; ++i) {
     const double k = std::nextafter(1.0 + (i / 2) / 7.0, 2.0);  // not exactly representable sums
     // The same stiffness with two kinds or particle flags: distinct entries.
-    const SpringProperties::Entry e{k, i % 2 == 0 ? SpringKind::face : SpringKind::body, i % 4 < 2};
+    const SpringProperties::Entry e{k, 7, i % 2 == 0 ? SpringKind::face : SpringKind::body,
+                                    i % 4 < 2};
     table.push_back(e);
     table.push_back(e);
     pushed.push_back(e);
@@ -294,11 +295,12 @@ TEST(LatticeSprings, PropertyTableKeepsEveryValueExactly) {
   ASSERT_EQ(table.size(), pushed.size());
   for (std::size_t s = 0; s < pushed.size(); ++s) {
     EXPECT_EQ(table[s].stiffness, pushed[s].stiffness) << s;
+    EXPECT_EQ(table[s].index_step, pushed[s].index_step) << s;
     EXPECT_EQ(table[s].kind, pushed[s].kind) << s;
     EXPECT_EQ(table[s].particle, pushed[s].particle) << s;
   }
   EXPECT_EQ(table.table().size(), 256u);
-  EXPECT_THROW(table.push_back({3.5, SpringKind::edge, false}), std::length_error);
+  EXPECT_THROW(table.push_back({3.5, 1, SpringKind::edge, false}), std::length_error);
   table.push_back(pushed[5]);  // a known entry still fits
   EXPECT_EQ(table[table.size() - 1], pushed[5]);
 
@@ -307,16 +309,19 @@ TEST(LatticeSprings, PropertyTableKeepsEveryValueExactly) {
                                    {Eigen::Vector3d(2.5e-6, 2.5e-6, 2.5e-6)}};
   const Lattice lat = build_lattice(spec);
   const std::vector<SpringProperties::Entry>& distinct = lat.springs.properties.table();
-  EXPECT_LE(distinct.size(), 15u);
-  std::set<std::tuple<double, int, bool>> seen;
+  EXPECT_LE(distinct.size(), 38u);
+  std::set<std::tuple<double, int, int, bool>> seen;
   bool any_particle = false;
   for (std::size_t i = 0; i < lat.springs.size(); ++i) {
-    seen.insert(
-        {lat.springs.stiffness(i), static_cast<int>(lat.springs.kind(i)), lat.springs.particle(i)});
+    const int step = lat.springs.second(i) - lat.springs.first[i];
+    seen.insert({lat.springs.stiffness(i), step, static_cast<int>(lat.springs.kind(i)),
+                 lat.springs.particle(i)});
     any_particle = any_particle || lat.springs.particle(i);
   }
-  std::set<std::tuple<double, int, bool>> listed;
-  for (const auto& e : distinct) listed.insert({e.stiffness, static_cast<int>(e.kind), e.particle});
+  std::set<std::tuple<double, int, int, bool>> listed;
+  for (const auto& e : distinct) {
+    listed.insert({e.stiffness, e.index_step, static_cast<int>(e.kind), e.particle});
+  }
   EXPECT_EQ(seen, listed);
   EXPECT_EQ(seen.size(), distinct.size());  // each entry once in the table
   EXPECT_TRUE(any_particle);

@@ -33,7 +33,7 @@ std::vector<std::vector<std::size_t>> incident_springs(const lat::Lattice& l) {
   std::vector<std::vector<std::size_t>> lists(static_cast<std::size_t>(l.node_count()));
   for (std::size_t s = 0; s < l.springs.size(); ++s) {
     lists[static_cast<std::size_t>(l.springs.first[s])].push_back(s);
-    lists[static_cast<std::size_t>(l.springs.second[s])].push_back(s);
+    lists[static_cast<std::size_t>(l.springs.second(s))].push_back(s);
   }
   return lists;
 }
@@ -46,7 +46,7 @@ void reference_gather(const lat::Lattice& l, Eigen::Matrix3Xd& out, W&& w) {
   for (Eigen::Index n = 0; n < out.cols(); ++n) {
     Eigen::Vector3d g = out.col(n);
     for (const std::size_t s : lists[static_cast<std::size_t>(n)]) {
-      if (l.springs.second[s] == n) {
+      if (l.springs.second(s) == n) {
         g += w(s);
       } else {
         g -= w(s);
@@ -72,7 +72,7 @@ void expect_kernel_matches_reference(const lat::Lattice& l) {
   EXPECT_EQ(with_gradient.rounding, energy_only.rounding);
   Eigen::Matrix3Xd expected = start;
   reference_gather(l, expected, [&](std::size_t s) {
-    const Eigen::Vector3d r = x.col(sp.second[s]) - x.col(sp.first[s]);
+    const Eigen::Vector3d r = x.col(sp.second(s)) - x.col(sp.first[s]);
     const double length = r.norm();
     const double tension = sp.stiffness(s) * (length - sp.rest_length(s)) / length;
     return Eigen::Vector3d(tension * r);
@@ -85,11 +85,11 @@ void expect_kernel_matches_reference(const lat::Lattice& l) {
   Eigen::Matrix3Xd expected_product = start;
   reference_gather(l, expected_product, [&](std::size_t s) {
     // The kernel's B (v_j - v_i) = k [(1 - L/l) dv + (L/l) u (u . dv)], term by term.
-    const Eigen::Vector3d r = x.col(sp.second[s]) - x.col(sp.first[s]);
+    const Eigen::Vector3d r = x.col(sp.second(s)) - x.col(sp.first[s]);
     const double length = r.norm();
     const double ratio = sp.rest_length(s) / length;
     const Eigen::Vector3d u = r / length;
-    const Eigen::Vector3d dv = v.col(sp.second[s]) - v.col(sp.first[s]);
+    const Eigen::Vector3d dv = v.col(sp.second(s)) - v.col(sp.first[s]);
     return Eigen::Vector3d(sp.stiffness(s) * ((1.0 - ratio) * dv + (ratio * u.dot(dv)) * u));
   });
   EXPECT_TRUE(product == expected_product)
@@ -149,7 +149,7 @@ TEST(GridStencil, GathersVisitSpringsAndCellsInIndexOrder) {
     std::vector<std::array<std::int64_t, 3>> expected;
     for (const auto& springs : incident_springs(l)) {
       for (const std::size_t s : springs) {
-        expected.push_back({static_cast<std::int64_t>(s), l.springs.first[s], l.springs.second[s]});
+        expected.push_back({static_cast<std::int64_t>(s), l.springs.first[s], l.springs.second(s)});
       }
     }
     EXPECT_EQ(visited, expected);
@@ -219,13 +219,11 @@ TEST(SpringKernel, GradientMatchesTheReferenceWithMoreThreadsThanEnergyBlocks) {
 TEST(SpringStencil, RefusesSpringsNumberedOtherwise) {
   lat::Lattice l = small_lattice(mess::model_profile("physical"), {2, 2, 2});
   EXPECT_NO_THROW(mess::SpringStencil{l});
-  lat::Lattice swapped = l;
-  std::swap(swapped.springs.first[3], swapped.springs.first[4]);
-  std::swap(swapped.springs.second[3], swapped.springs.second[4]);
-  EXPECT_THROW(mess::SpringStencil{swapped}, std::invalid_argument);
+  lat::Lattice moved = l;  // spring 3 starts at another node than the stencil's numbering says
+  moved.springs.first[3] += 1;
+  EXPECT_THROW(mess::SpringStencil{moved}, std::invalid_argument);
   lat::Lattice missing = l;
   missing.springs.first.pop_back();
-  missing.springs.second.pop_back();
   EXPECT_THROW(mess::SpringStencil{missing}, std::invalid_argument);
 }
 

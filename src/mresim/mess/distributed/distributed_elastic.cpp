@@ -74,7 +74,7 @@ DistributedElastic::DistributedElastic(const lattice::Lattice& lattice,
   for (std::size_t s = 0; s < springs.size(); ++s) {
     const std::array<int, 3> first = shape.node_coordinates(springs.first[s]);
     if (!ghosted.contains(first[0], first[1], first[2])) continue;
-    const std::array<int, 3> second = shape.node_coordinates(springs.second[s]);
+    const std::array<int, 3> second = shape.node_coordinates(springs.second(s));
     const std::array<int, 3> step = {second[0] - first[0], second[1] - first[1],
                                      second[2] - first[2]};
     const auto* const offset =

@@ -86,7 +86,6 @@ SpringSet build_springs(const GridShape& shape, double element_length,
   set.element_length = element_length;
   const auto expected = static_cast<std::size_t>(closed_form_spring_counts(shape).total());
   set.first.reserve(expected);
-  set.second.reserve(expected);
   set.properties.reserve(expected);
 
   // Bulk constants of the three kinds, and the same divided by the bulk cell counts.
@@ -118,11 +117,10 @@ SpringSet build_springs(const GridShape& shape, double element_length,
           const bool is_particle =
               pi >= 0 && pj >= 0 && (rule == ParticleSpringRule::any_particle || pi == pj);
           set.first.push_back(i);
-          set.second.push_back(j);
           set.properties.push_back(
               {is_particle ? particle_k[k]
                            : polymer_per_cell[k] * cells_containing(shape, ix, iy, iz, d),
-               kinds[n], is_particle});
+               j - i, kinds[n], is_particle});
         }
       }
     }

@@ -58,15 +58,19 @@ enum class ParticleSpringRule {
   any_particle,   // both ends are particle nodes, of any particles (the original code)
 };
 
-// Each spring's stiffness (N/m), kind and whether it got the particle constant, as a one-byte
-// index into a table of the lattice's distinct combinations: a lattice has at most 15 of them
-// (three kinds, weighted by the 1-4 cells holding a spring, and the particles' three
-// constants), so this keeps 1 byte per spring instead of 10 (about 115 bytes per node) and
-// gives back the same values bit for bit.
+// Each spring's stiffness (N/m), kind, whether it got the particle constant, and the index
+// step from its first node to its second, as a one-byte index into a table of the lattice's
+// distinct combinations: a lattice has at most 38 of them (13 forward offsets; per edge offset
+// the weights 1/4, 1/2, 1 of the bulk constant and the particle constant, per face-diagonal
+// offset 1/2, 1 and the particle's, per body diagonal 1 and the particle's), so this keeps
+// 1 byte per spring instead of 14 (about 160 bytes per node) and gives back the same values bit
+// for bit.
 class SpringProperties {
  public:
   struct Entry {
     double stiffness = 0.0;  // N/m
+    // second - first: the node index step of the spring's forward offset on this grid.
+    std::int32_t index_step = 0;
     SpringKind kind = SpringKind::edge;
     bool particle = false;
     bool operator==(const Entry&) const = default;
@@ -84,14 +88,15 @@ class SpringProperties {
   std::vector<std::uint8_t> index_;
 };
 
-// Springs as parallel arrays (structure of arrays), first[s] < second[s].
+// Springs as parallel arrays (structure of arrays): the first node of each spring, and its
+// properties byte, which also gives the second node: first(s) < second(s).
 struct SpringSet {
   std::vector<std::int32_t> first;
-  std::vector<std::int32_t> second;
   SpringProperties properties;
   double element_length = 0.0;  // m
 
   std::size_t size() const { return first.size(); }
+  std::int32_t second(std::size_t s) const { return first[s] + properties[s].index_step; }
   double stiffness(std::size_t s) const { return properties[s].stiffness; }  // N/m
   SpringKind kind(std::size_t s) const { return properties[s].kind; }
   // True if the spring got the particle constant.

@@ -200,7 +200,7 @@ struct MessGeometry {
   std::size_t particle_count() const { return centre_cells.size(); }
 };
 
-// At most this many nodes (a run needs ~1,100 bytes each: kBytesPerNode, check_memory); larger
+// At most this many nodes (a run needs ~1,000 bytes each: kBytesPerNode, check_memory); larger
 // boxes are rejected before anything of that size is allocated.
 inline constexpr std::int64_t kMaxNodes = 100'000'000;
 
@@ -283,8 +283,8 @@ MessSpec read_mess_run_file(const config::TableReader& root);
 // Measured peak resident memory of a 3D run with the minimiser, per lattice node (nodes,
 // springs, cells, forces, the minimiser's history, the seed's correction passes and the
 // checkpoint copy together): the full-size Fig. 4.11 pair (284,592 nodes, two steps with a
-// correction pass) peaks at 1,069 bytes per node, the process's own memory included, rounded up.
-inline constexpr std::int64_t kBytesPerNode = 1100;
+// correction pass) peaks at 991 bytes per node, the process's own memory included, rounded up.
+inline constexpr std::int64_t kBytesPerNode = 1000;
 // The same with solver.method = "newton": the elastic Hessian's sparse matrix (81 entries per
 // row, 2.9 kB per node) and the multigrid built on it come on top; measured peak RSS 311 MiB at
 // 48,600 nodes and 1,696 MiB at 284,592 nodes (the full-size Fig. 4.11 pair), a slope of

@@ -47,7 +47,7 @@ ElasticMatrix::ElasticMatrix(const lattice::Lattice& lat) {
   const lattice::SpringSet& sp = lat.springs;
   for (std::size_t s = 0; s < sp.size(); ++s) {
     ++count[static_cast<std::size_t>(sp.first[s]) + 1];
-    ++count[static_cast<std::size_t>(sp.second[s]) + 1];
+    ++count[static_cast<std::size_t>(sp.second(s)) + 1];
   }
   count[0] = 0;
   for (std::int64_t k = 0; k < n; ++k) count[k + 1] += count[k];
@@ -64,8 +64,8 @@ ElasticMatrix::ElasticMatrix(const lattice::Lattice& lat) {
     }
   }
   for (std::size_t s = 0; s < sp.size(); ++s) {
-    push(sp.first[s], sp.second[s]);
-    push(sp.second[s], sp.first[s]);
+    push(sp.first[s], sp.second(s));
+    push(sp.second(s), sp.first[s]);
   }
   neighbour_start_.assign(static_cast<std::size_t>(n) + 1, 0);
   neighbours_.reserve(static_cast<std::size_t>(27 * n));

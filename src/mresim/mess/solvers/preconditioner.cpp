@@ -15,10 +15,10 @@ RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& syste
   Eigen::Matrix3Xd d = Eigen::Matrix3Xd::Zero(3, lat.node_count());
   const lattice::SpringSet& sp = lat.springs;
   for (std::size_t s = 0; s < sp.size(); ++s) {
-    const Eigen::Vector3d e = (x0.col(sp.second[s]) - x0.col(sp.first[s])).normalized();
+    const Eigen::Vector3d e = (x0.col(sp.second(s)) - x0.col(sp.first[s])).normalized();
     const Eigen::Vector3d h = sp.stiffness(s) * e.cwiseAbs2();
     d.col(sp.first[s]) += h;
-    d.col(sp.second[s]) += h;
+    d.col(sp.second(s)) += h;
   }
   // Volume term: kappa V0 (dV/dx / V0)^2 with |dV/dx_a| = l_e^2/4 at rest, per cell.
   const double cell =

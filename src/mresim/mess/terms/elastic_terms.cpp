@@ -31,7 +31,7 @@ double spring_energy(const lattice::SpringSet& springs, const Eigen::Matrix3Xd& 
   double energy = 0.0;
   for (std::size_t s = 0; s < springs.size(); ++s) {
     const double stretch =
-        (x.col(springs.second[s]) - x.col(springs.first[s])).norm() - springs.rest_length(s);
+        (x.col(springs.second(s)) - x.col(springs.first[s])).norm() - springs.rest_length(s);
     energy += 0.5 * springs.stiffness(s) * stretch * stretch;  // eq. 4.62
   }
   return energy;
@@ -40,11 +40,11 @@ double spring_energy(const lattice::SpringSet& springs, const Eigen::Matrix3Xd& 
 void add_spring_gradient(const lattice::SpringSet& springs, const Eigen::Matrix3Xd& x,
                          Eigen::Matrix3Xd& gradient) {
   for (std::size_t s = 0; s < springs.size(); ++s) {
-    const Eigen::Vector3d r = x.col(springs.second[s]) - x.col(springs.first[s]);
+    const Eigen::Vector3d r = x.col(springs.second(s)) - x.col(springs.first[s]);
     const double l = r.norm();
     // eq. 4.63: the force on the second end is -k (l - L) r^; the gradient is its negative.
     const Eigen::Vector3d g = springs.stiffness(s) * (l - springs.rest_length(s)) / l * r;
-    gradient.col(springs.second[s]) += g;
+    gradient.col(springs.second(s)) += g;
     gradient.col(springs.first[s]) -= g;
   }
 }
@@ -152,7 +152,7 @@ void for_each_item(std::int64_t n, Body&& body) {
 // The spring's Hessian block B = k [(1 - L/l) I + (L/l) r^ r^T].
 Eigen::Matrix3d spring_block(const lattice::SpringSet& sp, std::size_t s,
                              const Eigen::Matrix3Xd& x) {
-  const Eigen::Vector3d r = x.col(sp.second[s]) - x.col(sp.first[s]);
+  const Eigen::Vector3d r = x.col(sp.second(s)) - x.col(sp.first[s]);
   const double l = r.norm();
   const double ratio = sp.rest_length(s) / l;
   const Eigen::Vector3d u = r / l;
@@ -165,8 +165,9 @@ elastic::SpringValue spring_at(const lattice::SpringSet& sp,
                                const std::array<double, 3>& rest_length, const Eigen::Matrix3Xd& x,
                                std::int64_t s) {
   const auto u = static_cast<std::size_t>(s);
-  const double l = (x.col(sp.second[u]) - x.col(sp.first[u])).norm();
   const lattice::SpringProperties::Entry& spring = sp.properties[u];  // one byte read
+  const std::int64_t first = sp.first[u];
+  const double l = (x.col(first + spring.index_step) - x.col(first)).norm();
   return elastic::spring_value(spring.stiffness, rest_length[static_cast<std::size_t>(spring.kind)],
                                l);
 }
@@ -315,12 +316,14 @@ void SpringKernel::add_hessian_product(const lattice::Lattice& lat, const Eigen:
   // +w_s on the second end, -w_s on the first.
   for_each_item(static_cast<std::int64_t>(sp.size()), [&](std::int64_t s) {
     const auto i = static_cast<std::size_t>(s);
-    const Eigen::Vector3d r = x.col(sp.second[i]) - x.col(sp.first[i]);
-    const double l = r.norm();
     const lattice::SpringProperties::Entry& spring = sp.properties[i];
+    const std::int64_t first = sp.first[i];
+    const std::int64_t second = first + spring.index_step;
+    const Eigen::Vector3d r = x.col(second) - x.col(first);
+    const double l = r.norm();
     const double ratio = rest_length[static_cast<std::size_t>(spring.kind)] / l;
     const Eigen::Vector3d u = r / l;
-    const Eigen::Vector3d dv = v.col(sp.second[i]) - v.col(sp.first[i]);
+    const Eigen::Vector3d dv = v.col(second) - v.col(first);
     Eigen::Map<Eigen::Vector3d>(scratch_.data() + 3 * s) =
         spring.stiffness * ((1.0 - ratio) * dv + (ratio * u.dot(dv)) * u);
   });
@@ -335,7 +338,7 @@ void SpringKernel::add_hessian_blocks(const lattice::Lattice& lat, const Eigen::
   for (std::size_t s = 0; s < sp.size(); ++s) {
     const Eigen::Matrix3d block = spring_block(sp, s, x);
     const std::int64_t i = sp.first[s];
-    const std::int64_t j = sp.second[s];
+    const std::int64_t j = sp.second(s);
     sink.add(i, i, block);
     sink.add(j, j, block);
     sink.add(i, j, -block);

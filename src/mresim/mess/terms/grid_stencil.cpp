@@ -53,7 +53,7 @@ SpringStencil::SpringStencil(const lattice::Lattice& lattice) : shape_(lattice.s
       const int jy = c[1] + d[1];
       const int jz = c[2] + d[2];
       if (jx < 0 || jx >= nx || jy < 0 || jy >= ny || jz < 0 || jz >= nz) continue;
-      if (s >= springs.size() || springs.first[s] != n || springs.second[s] != n + delta_[o]) {
+      if (s >= springs.size() || springs.first[s] != n || springs.second(s) != n + delta_[o]) {
         throw std::invalid_argument("SpringStencil: spring " + std::to_string(s) +
                                     " is not the forward-neighbour spring of node " +
                                     std::to_string(n) + " the stencil expects");
