@@ -48,7 +48,7 @@ struct LinePoint {
 // use_energy = false: forces only (a field that is not exactly a gradient): the energy tests
 // are dropped and the search brackets the zero of the slope g(alpha) . d.
 bool wolfe_line_search(Objective& f, const Eigen::VectorXd& u, const Eigen::VectorXd& d,
-                       const LinePoint& from, double alpha_init, double alpha_max,
-                       bool use_energy, LinePoint& out);
+                       const LinePoint& from, double alpha_init, double alpha_max, bool use_energy,
+                       LinePoint& out);
 
 }  // namespace mresim::mess::detail
