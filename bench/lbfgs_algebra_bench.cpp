@@ -68,7 +68,7 @@ double best_ms(int repeats, F&& f) {
 
 int main(int argc, char** argv) {
   int repeats = 20;
-  Eigen::Index n = 3 * 284592;
+  Eigen::Index n = Eigen::Index{3} * 284592;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     if (key == "--repeats") {
@@ -94,7 +94,7 @@ int main(int argc, char** argv) {
     const Eigen::VectorXd g_new = g_old + curvature.cwiseProduct(d);
     memory.add(1.0, d, g_new, g_old, kPairs);
     s.push_back(d);
-    y.push_back(g_new - g_old);
+    y.emplace_back(g_new - g_old);
   }
   const double scale = s.back().dot(y.back()) / y.back().dot(p_diagonal.cwiseProduct(y.back()));
   const Eigen::VectorXd g = random_vector(n, random);

@@ -22,9 +22,8 @@ void BoundaryConstraints::hold(std::int64_t node, int axis, double value) {
                                 std::to_string(fixed.size() / 3) + " nodes)");
   }
   fixed[3 * n + static_cast<std::size_t>(axis)] = 1;
-  auto [entry, added] =
-      prescribed_.try_emplace(static_cast<std::int32_t>(node), Eigen::Vector3d::Zero());
-  entry->second[axis] = value;
+  prescribed_.try_emplace(static_cast<std::int32_t>(node), Eigen::Vector3d::Zero())
+      .first->second[axis] = value;
 }
 
 void BoundaryConstraints::hold(std::int64_t node, const Eigen::Vector3d& position) {
