@@ -27,14 +27,12 @@ bool StallGuard::stalled(const Eigen::VectorXd& g, double change, const Objectiv
   return ++count_ >= limit_;
 }
 
+// At full size every gradient is 24 bytes per node, so the search keeps only the ones it may
+// return: not the start's (alpha = 0 is never accepted) nor the upper ends' of the zoom.
 bool wolfe_line_search(Objective& f, const Eigen::VectorXd& u, const Eigen::VectorXd& d,
                        const LinePoint& from, double alpha_init, double alpha_max, bool use_energy,
                        LinePoint& out) {
-  // At full size every gradient is 24 bytes per node, so the search keeps only the ones it may
-  // return: not the start's (alpha = 0 is never accepted) nor the upper ends' of the zoom.
-  LinePoint start;
-  start.phi = from.phi;
-  start.dphi = from.dphi;
+  const LinePoint start{0.0, from.phi, from.dphi, {}};
   constexpr double c1 = 1e-4;
   constexpr double c2 = 0.9;
   constexpr int kMaxTrials = 40;
