@@ -56,7 +56,8 @@ void LbfgsMemory::add(double alpha, const Eigen::VectorXd& d, const Eigen::Vecto
 }
 
 Eigen::VectorXd LbfgsMemory::times(const Eigen::VectorXd& g, const Preconditioner& P) {
-  Eigen::VectorXd q = g;
+  Eigen::VectorXd q;
+  parallel_copy(g, q);
   const int m = size();
   const auto at = [](int k) { return static_cast<std::size_t>(k); };
   std::vector<double> a(at(m));

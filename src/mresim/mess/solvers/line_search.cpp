@@ -11,7 +11,7 @@ namespace mresim::mess::detail {
 
 bool StallGuard::stalled(const Eigen::VectorXd& g, double change, const Objective& f,
                          bool use_energy) {
-  const double gmax = g.cwiseAbs().maxCoeff();
+  const double gmax = parallel_max_abs(g);
   // An energy decrease counts as progress down to eps times the potential's rounding scale:
   // the bound on the rounding of a sum, which its typical rounding stays well below. With
   // 64 eps (the line search's slack), a full-size pair in contact (Fig. 4.11 at 40 mT,

@@ -122,7 +122,7 @@ InnerResult run_lbfgs(Objective& f, Eigen::VectorXd& u, int budget, const Minimi
   StallGuard guard(cur.g, kStallIterations);
   while (r.iterations < budget) {
     Eigen::VectorXd d = memory.times(cur.g, P);
-    d = -d;  // in place: no second vector
+    detail::parallel_scale(-1.0, d);  // d = -d in place (exact): no second vector
     cur.dphi = detail::parallel_dot(cur.g, d);
     if (!(cur.dphi < 0.0)) {  // not a descent direction: restart from steepest descent
       memory.clear();

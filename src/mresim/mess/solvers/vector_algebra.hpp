@@ -56,6 +56,25 @@ inline void parallel_axpy(double alpha, const Eigen::VectorXd& x, Eigen::VectorX
   });
 }
 
+// y = x (resized), copied in parallel: at full size a copy is 8 MB.
+inline void parallel_copy(const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  y.resize(x.size());
+  (void)sum_over_blocks(y.size(), [&](Eigen::Index begin, Eigen::Index length) {
+    y.segment(begin, length) = x.segment(begin, length);
+    return 0.0;
+  });
+}
+
+// out = a .* b (resized)
+inline void parallel_product(const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                             Eigen::VectorXd& out) {
+  out.resize(a.size());
+  (void)sum_over_blocks(out.size(), [&](Eigen::Index begin, Eigen::Index length) {
+    out.segment(begin, length) = a.segment(begin, length).cwiseProduct(b.segment(begin, length));
+    return 0.0;
+  });
+}
+
 // y *= alpha
 inline void parallel_scale(double alpha, Eigen::VectorXd& y) {
   (void)sum_over_blocks(y.size(), [&](Eigen::Index begin, Eigen::Index length) {

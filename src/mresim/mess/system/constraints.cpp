@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "mresim/mess/system/fixed_order.hpp"
+
 namespace mresim::mess {
 
 BoundaryConstraints BoundaryConstraints::none(std::int64_t node_count) {
@@ -145,13 +147,21 @@ DofMap::DofMap(const BoundaryConstraints& constraints, const Eigen::Matrix3Xd& r
   }
 }
 
+// The own dofs (one free coordinate each) are written elementwise, in the fixed blocks of
+// detail::for_each_block, so that at full size (a million dofs) both cores share these passes
+// with the same results as a serial loop; the rigid groups' few translations and sums over their
+// nodes stay serial, in node order.
+
 Eigen::VectorXd DofMap::to_dofs(const Eigen::Matrix3Xd& x) const {
   Eigen::VectorXd u(size());
   const double inv = 1.0 / length_scale_;
   const double* data = x.data();
-  const auto nc = static_cast<Eigen::Index>(coordinates_.size());
-  for (Eigen::Index k = 0; k < nc; ++k)
-    u[k] = data[coordinates_[static_cast<std::size_t>(k)]] * inv;
+  detail::for_each_block(own_dofs(), [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t k = begin; k < end; ++k) {
+      u[k] = data[coordinates_[static_cast<std::size_t>(k)]] * inv;
+    }
+  });
+  const Eigen::Index nc = own_dofs();
   for (Eigen::Index g = 0; g < groups(); ++g) {
     const auto gi = static_cast<std::size_t>(g);
     u.segment<3>(nc + 3 * g) = (x.col(group_nodes_[gi][0]) - group_reference_[gi].col(0)) * inv;
@@ -162,10 +172,12 @@ Eigen::VectorXd DofMap::to_dofs(const Eigen::Matrix3Xd& x) const {
 template <class Dofs>
 void DofMap::write_positions(const Dofs& u, Eigen::Matrix3Xd& x) const {
   double* data = x.data();
-  const auto nc = static_cast<Eigen::Index>(coordinates_.size());
-  for (Eigen::Index k = 0; k < nc; ++k) {
-    data[coordinates_[static_cast<std::size_t>(k)]] = u[k] * length_scale_;
-  }
+  detail::for_each_block(own_dofs(), [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t k = begin; k < end; ++k) {
+      data[coordinates_[static_cast<std::size_t>(k)]] = u[k] * length_scale_;
+    }
+  });
+  const Eigen::Index nc = own_dofs();
   for (Eigen::Index g = 0; g < groups(); ++g) {
     const auto gi = static_cast<std::size_t>(g);
     const Eigen::Vector3d t = u.template segment<3>(nc + 3 * g) * length_scale_;
@@ -187,10 +199,12 @@ void DofMap::to_positions(const Eigen::VectorXd& u, double alpha, const Eigen::V
 template <class Visit>
 void DofMap::for_each_reduced(const Eigen::Matrix3Xd& gradient, Visit&& visit) const {
   const double* data = gradient.data();
-  const auto nc = static_cast<Eigen::Index>(coordinates_.size());
-  for (Eigen::Index k = 0; k < nc; ++k) {
-    visit(k, data[coordinates_[static_cast<std::size_t>(k)]] * length_scale_);
-  }
+  detail::for_each_block(own_dofs(), [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t k = begin; k < end; ++k) {
+      visit(k, data[coordinates_[static_cast<std::size_t>(k)]] * length_scale_);
+    }
+  });
+  const Eigen::Index nc = own_dofs();
   for (Eigen::Index gr = 0; gr < groups(); ++gr) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (const std::int32_t n : group_nodes_[static_cast<std::size_t>(gr)]) sum += gradient.col(n);
@@ -210,20 +224,37 @@ void DofMap::reduce_divided(const Eigen::Matrix3Xd& gradient, double divisor,
   for_each_reduced(gradient, [&](Eigen::Index k, double value) { out[k] = value / divisor; });
 }
 
+namespace {
+
+// m = max(m, a), where a NaN stays: it must never pass a tolerance.
+void keep_largest(double a, double& m) {
+  if (a > m || std::isnan(a)) m = a;
+}
+
+}  // namespace
+
 double DofMap::max_abs_reduced_divided(const Eigen::Matrix3Xd& gradient, double divisor) const {
-  double m = 0.0;
-  for_each_reduced(gradient, [&](Eigen::Index, double value) {
-    const double a = std::abs(value / divisor);
-    if (a > m || std::isnan(a)) m = a;  // a NaN stays: it must never pass a tolerance
+  // One maximum per block of dofs (a group's three components count as the last block's),
+  // then the largest of those: the maximum is exact in any order.
+  const std::int64_t blocks = (size() + detail::kSumBlock - 1) / detail::kSumBlock;
+  std::vector<double> largest(static_cast<std::size_t>(std::max<std::int64_t>(blocks, 1)), 0.0);
+  for_each_reduced(gradient, [&](Eigen::Index k, double value) {
+    keep_largest(std::abs(value / divisor),
+                 largest[static_cast<std::size_t>(k / detail::kSumBlock)]);
   });
+  double m = 0.0;
+  for (const double a : largest) keep_largest(a, m);
   return m;
 }
 
 Eigen::Matrix3Xd DofMap::expand(const Eigen::VectorXd& v) const {
   Eigen::Matrix3Xd x = Eigen::Matrix3Xd::Zero(3, static_cast<Eigen::Index>(dof_index_.size() / 3));
   double* data = x.data();
-  const auto nc = static_cast<Eigen::Index>(coordinates_.size());
-  for (Eigen::Index k = 0; k < nc; ++k) data[coordinates_[static_cast<std::size_t>(k)]] = v[k];
+  detail::for_each_block(own_dofs(), [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t k = begin; k < end; ++k)
+      data[coordinates_[static_cast<std::size_t>(k)]] = v[k];
+  });
+  const Eigen::Index nc = own_dofs();
   for (Eigen::Index g = 0; g < groups(); ++g) {
     const Eigen::Vector3d t = v.segment<3>(nc + 3 * g);
     for (const std::int32_t n : group_nodes_[static_cast<std::size_t>(g)]) x.col(n) = t;

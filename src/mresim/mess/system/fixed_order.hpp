@@ -22,6 +22,19 @@ inline constexpr std::int64_t kSumBlock = 4096;
 // more than it saves (and much more on a loaded machine). The result is the same either way.
 inline constexpr std::int64_t kParallelMinimum = 16384;
 
+// body(begin, end) for the fixed blocks [begin, end) of [0, n), in parallel for long ranges.
+// For elementwise work (each index written by its own block only): the results are those of a
+// serial loop whatever the thread count. `body` must not throw.
+template <class Body>
+void for_each_block(std::int64_t n, Body&& body) {
+  if (n <= 0) return;
+  const std::int64_t blocks = (n + kSumBlock - 1) / kSumBlock;
+#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
+  for (std::int64_t b = 0; b < blocks; ++b) {
+    body(b * kSumBlock, (b + 1) * kSumBlock < n ? (b + 1) * kSumBlock : n);
+  }
+}
+
 // sum_{i < n} term(i), bitwise independent of the thread count.
 template <class Term>
 double fixed_order_sum(std::int64_t n, Term&& term) {

@@ -298,7 +298,11 @@ Evaluation MessSystem::evaluate(Eigen::Matrix3Xd* gradient) {
     TermGradient g;
     if (gradient != nullptr) {
       g.nodes = std::move(*gradient);  // reuse the caller's storage
-      g.nodes.setZero(3, lattice_.node_count());
+      g.nodes.resize(3, lattice_.node_count());
+      double* zero = g.nodes.data();  // zeroed on both cores: 24 bytes per node
+      detail::for_each_block(g.nodes.size(), [zero](std::int64_t begin, std::int64_t end) {
+        std::fill(zero + begin, zero + end, 0.0);
+      });
       g.centres.setZero(3, state.centres.cols());
     }
     std::vector<TermValue> values(terms_.size());
