@@ -12,7 +12,6 @@
 #include <omp.h>
 
 #include <array>
-#include <cmath>
 #include <cstdint>
 #include <stdexcept>
 #include <utility>
@@ -252,32 +251,4 @@ TEST(VolumeKernel, GradientMatchesTheReferenceOnEveryThreadCount) {
     expect_volume_kernel_matches_reference(wide_layers, 1.0);
   }
   omp_set_num_threads(saved);
-}
-
-TEST(SpringValues, PackedArithmeticGivesSpringValueBitwise) {
-  // Stretched and compressed springs of both stiffnesses, an odd count (the scalar tail).
-  constexpr std::size_t n = 37;
-  std::array<double, n> squared{};
-  std::array<double, n> stiffness{};
-  std::array<double, n> rest{};
-  for (std::size_t i = 0; i < n; ++i) {
-    const double length = 1e-7 * (0.7 + 0.013 * static_cast<double>(i * i % 53));
-    squared[i] = length * length;
-    stiffness[i] = i % 3 == 0 ? 2.7e4 : 2.7;
-    rest[i] = 1e-7 * (i % 2 == 0 ? 1.0 : std::sqrt(2.0));
-  }
-  std::array<double, n> tension{};
-  std::array<double, n> energy{};
-  std::array<double, n> rounding{};
-  mess::elastic::spring_values(n, {squared.data(), stiffness.data(), rest.data(), tension.data(),
-                                   energy.data(), rounding.data()});
-  for (std::size_t i = 0; i < n; ++i) {
-    SCOPED_TRACE(i);
-    const mess::elastic::SpringValue v =
-        mess::elastic::spring_value(stiffness[i], rest[i], std::sqrt(squared[i]));
-    EXPECT_EQ(tension[i], v.tension);
-    EXPECT_EQ(energy[i], v.energy);
-    EXPECT_EQ(rounding[i], v.rounding);
-    EXPECT_NE(v.tension, 0.0);
-  }
 }

@@ -8,10 +8,6 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cmath>
-#include <cstddef>
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 #include "mresim/mess/lattice/springs.hpp"
 #include "mresim/mess/lattice/volume_elements.hpp"
@@ -42,43 +38,6 @@ inline SpringValue spring_value(double k, double rest_length, double l) {
   const double stretch = l - rest_length;
   const double k_stretch = k * stretch;
   return {k * stretch / l, 0.5 * k_stretch * stretch, std::abs(k_stretch) * l};
-}
-
-// spring_value for springs i < n whose ends are sqrt(squared_length[i]) apart, into arrays of
-// n. Where the CPU has SSE2 (every x86-64) two springs share each instruction: the same
-// correctly rounded operations, elementwise and in the same order, so the values are bitwise
-// spring_value's. The square root and the division dominate a spring's cost, and a packed
-// instruction does two of them in about the time of one.
-struct SpringArrays {
-  const double* squared_length;
-  const double* stiffness;
-  const double* rest_length;
-  double* tension;
-  double* energy;
-  double* rounding;
-};
-
-inline void spring_values(std::size_t n, const SpringArrays& a) {
-  std::size_t i = 0;
-#if defined(__SSE2__)
-  const __m128d half = _mm_set1_pd(0.5);
-  const __m128d sign = _mm_set1_pd(-0.0);
-  for (; i + 2 <= n; i += 2) {
-    const __m128d l = _mm_sqrt_pd(_mm_loadu_pd(a.squared_length + i));
-    const __m128d stretch = _mm_sub_pd(l, _mm_loadu_pd(a.rest_length + i));
-    const __m128d k_stretch = _mm_mul_pd(_mm_loadu_pd(a.stiffness + i), stretch);
-    _mm_storeu_pd(a.tension + i, _mm_div_pd(k_stretch, l));
-    _mm_storeu_pd(a.energy + i, _mm_mul_pd(_mm_mul_pd(half, k_stretch), stretch));
-    _mm_storeu_pd(a.rounding + i, _mm_mul_pd(_mm_andnot_pd(sign, k_stretch), l));
-  }
-#endif
-  for (; i < n; ++i) {
-    const SpringValue v =
-        spring_value(a.stiffness[i], a.rest_length[i], std::sqrt(a.squared_length[i]));
-    a.tension[i] = v.tension;
-    a.energy[i] = v.energy;
-    a.rounding[i] = v.rounding;
-  }
 }
 
 // One cell, eq. 4.64 x V0 with V = a . (b x c) (eq. 4.48): its energy 1/2 kappa V0 (V/V0 - 1)^2

@@ -80,23 +80,6 @@ namespace {
 // Nodes whose springs evaluate_with_gradient computes in one flat pass before gathering them.
 constexpr std::int64_t kChunkNodes = 512;
 
-// Springs whose values the flat pass computes at once (elastic::spring_values): its arrays,
-// 12 KB, stay in the first-level cache.
-constexpr std::int64_t kSpringBatch = 256;
-struct SpringBatch {
-  std::array<double, kSpringBatch> squared_length;
-  std::array<double, kSpringBatch> stiffness;
-  std::array<double, kSpringBatch> rest_length;
-  std::array<double, kSpringBatch> tension;
-  std::array<double, kSpringBatch> energy;
-  std::array<double, kSpringBatch> rounding;
-
-  elastic::SpringArrays arrays() {
-    return {squared_length.data(), stiffness.data(), rest_length.data(),
-            tension.data(),        energy.data(),    rounding.data()};
-  }
-};
-
 // The energy sums of the fused kernels, bitwise those of detail::fixed_order_sums: the items
 // are split into the same blocks of kSumBlock, each thread takes a contiguous run of blocks
 // (own_items) and sums each of them serially in index order (OwnBlockSums), and the block sums
@@ -284,28 +267,12 @@ ElasticValue SpringKernel::evaluate_with_gradient(const lattice::Lattice& lat,
     // Tensions of the springs of the nodes [next, end), in one flat pass as a whole-array
     // pass would do it, into the ring; the energy of those that are this thread's.
     std::int64_t next = std::max<std::int64_t>(0, node_begin - behind);
-    // A batch of springs at a time: their squared lengths and constants gathered, then their
-    // values in packed arithmetic (elastic::spring_values), then the ring and the energy sums
-    // in spring order.
-    SpringBatch batch;
     const auto compute_through = [&](std::int64_t end) {
       const std::int64_t stop = stencil_.first_spring(end);
-      for (std::int64_t from = stencil_.first_spring(next); from < stop; from += kSpringBatch) {
-        const auto count = static_cast<std::size_t>(std::min(kSpringBatch, stop - from));
-        for (std::size_t i = 0; i < count; ++i) {
-          const auto u = static_cast<std::size_t>(from) + i;
-          const lattice::SpringProperties::Entry& spring = sp.properties[u];
-          const std::int64_t first = sp.first[u];
-          batch.squared_length[i] = (x.col(first + spring.index_step) - x.col(first)).squaredNorm();
-          batch.stiffness[i] = spring.stiffness;
-          batch.rest_length[i] = rest_length[static_cast<std::size_t>(spring.kind)];
-        }
-        elastic::spring_values(count, batch.arrays());
-        for (std::size_t i = 0; i < count; ++i) {
-          const std::int64_t s = from + static_cast<std::int64_t>(i);
-          ring[static_cast<std::uint64_t>(s) & mask] = batch.tension[i];
-          sums.add(s, batch.energy[i], batch.rounding[i]);
-        }
+      for (std::int64_t s = stencil_.first_spring(next); s < stop; ++s) {
+        const elastic::SpringValue value = spring_at(sp, rest_length, x, s);
+        ring[static_cast<std::uint64_t>(s) & mask] = value.tension;
+        sums.add(s, value.energy, value.rounding);
       }
       next = end;
     };
