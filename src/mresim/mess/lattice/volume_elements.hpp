@@ -33,8 +33,8 @@ std::vector<std::array<std::int32_t, 8>> build_elements(const GridShape& shape);
 
 // The same cells computed from the grid when asked for, instead of stored: 8 indices per cell
 // would take 32 bytes per node. A random-access range of std::array<std::int32_t, 8>
-// (by value): cells[c], cells.size(), and range-for. Vertex v of the cell with lower corner
-// node n0 is n0 + vertex_step(v).
+// (by value): cells[c], cells.size(), and range-for; cell_at(n0) is the cell whose lower
+// corner is node n0.
 class GridCells {
  public:
   using Cell = std::array<std::int32_t, 8>;
@@ -46,9 +46,7 @@ class GridCells {
   bool empty() const { return count_ == 0; }
   // The lower corner node (local vertex 0) of cell c.
   std::int64_t corner(std::int64_t c) const;
-  // Node index step from a cell's vertex 0 to its vertex v.
-  std::int64_t vertex_step(int v) const { return step_[static_cast<std::size_t>(v)]; }
-  Cell operator[](std::size_t c) const { return cell_at(static_cast<std::int64_t>(corner_of(c))); }
+  Cell operator[](std::size_t c) const { return cell_at(corner(static_cast<std::int64_t>(c))); }
   // The cell whose lower corner is node n0.
   Cell cell_at(std::int64_t n0) const {
     Cell e{};
@@ -77,11 +75,9 @@ class GridCells {
   Iterator end() const { return {this, size()}; }
 
  private:
-  std::int64_t corner_of(std::size_t c) const { return corner(static_cast<std::int64_t>(c)); }
-
   GridShape shape_;
   std::int64_t count_ = 0;
-  std::array<std::int64_t, 8> step_{};
+  std::array<std::int64_t, 8> step_{};  // node index step from vertex 0 to vertex v
 };
 
 using CellVertices = std::array<Eigen::Vector3d, 8>;
