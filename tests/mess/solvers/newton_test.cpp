@@ -179,6 +179,44 @@ TEST(MessObjective, ConstantLoadAddsItsGradientAndItsWork) {
   EXPECT_LT(max_abs(again - plain), 1e-9 * max_abs(plain));
 }
 
+// The seed's load acts on the particle nodes only, and the objective keeps it there: the work
+// load . (u - u_ref) over those components, the same at a line search's trial point
+// u + alpha d as at that point formed whole (to the magnetization's tolerance).
+TEST(MessObjective, LoadOnAFewNodesAddsItsWorkAlongALine) {
+  mess::MessSystem sys = pair_in_field();
+  sys.set_positions(perturbed(sys.positions(), 0.02 * sys.length_scale()));
+  const double f0 = mess::LeapfrogScales::of(sys.lattice()).k_eff * sys.length_scale();
+  const mess::DofMap map(sys.constraints(), sys.positions(), sys.length_scale());
+  mess::detail::Objective f(sys, map, f0);
+  const Eigen::VectorXd u = map.to_dofs(sys.positions());
+  // A direction of up to 0.01 per dof (units of l_e).
+  const Eigen::VectorXd d =
+      map.reduce(perturbed(Eigen::Matrix3Xd::Zero(3, sys.node_count()), 0.01, 4)) /
+      sys.length_scale();
+  Eigen::Matrix3Xd load = Eigen::Matrix3Xd::Zero(3, sys.node_count());
+  for (const Eigen::Index n : {Eigen::Index{3}, Eigen::Index{17}, sys.node_count() - 2}) {
+    load.col(n) = Eigen::Vector3d(0.3, -1.1, 0.7) * f0 * static_cast<double>(n % 5 + 1);
+  }
+  const Eigen::VectorXd u_ref = u - 0.2 * d;
+  const Eigen::VectorXd trial = u + 0.5 * d;
+  Eigen::VectorXd plain;
+  const double phi_plain = f(trial, plain);
+  f.set_load(load, u_ref);
+  Eigen::VectorXd at_trial;
+  const double phi_trial = f(trial, at_trial);
+  Eigen::VectorXd along;
+  const double phi_along = f.along(u, 0.5, d, along);
+  const Eigen::VectorXd load_dofs = map.reduce(load) / f.energy_scale();
+  ASSERT_GT(max_abs(load_dofs), 0.0);
+  const double work = load_dofs.dot(trial - u_ref);
+  EXPECT_GT(std::abs(work), 1e-6 * std::abs(phi_plain));
+  EXPECT_NEAR(phi_trial - phi_plain, work, 1e-12 * std::abs(phi_plain));
+  // (M is re-solved at each evaluation from where the last one left it: equal to its tolerance.)
+  EXPECT_NEAR(phi_along, phi_trial, 1e-13 * std::abs(phi_trial));
+  EXPECT_LT(max_abs(along - at_trial), 1e-12 * max_abs(at_trial));
+  EXPECT_LT(max_abs(at_trial - plain - load_dofs), 1e-12 * max_abs(plain));
+}
+
 TEST(MessNewton, HessianProductMatchesDifferencesOfTheObjectiveGradient) {
   for (const bool with_group : {false, true}) {
     mess::MessSystem sys = pair_in_field();

@@ -504,10 +504,11 @@ class Minimisation {
       res_.status = MinimiserStatus::converged;
       return false;
     }
-    const Eigen::Matrix3Xd seed_gradient = f_.full_gradient();
+    Eigen::Matrix3Xd load = f_.full_gradient();  // the seed's gradient at x_k
     rules_.set_centre_rule(CentreRule::all_nodes);
     evaluate_here();
-    f_.set_load(seed_gradient - f_.full_gradient(), u_);
+    load -= f_.full_gradient();  // in place: no second full-size temporary
+    f_.set_load(load, u_);
     ++correction_passes_;
     return true;
   }

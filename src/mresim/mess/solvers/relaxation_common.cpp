@@ -64,14 +64,16 @@ double Objective::evaluate_here(const Dofs& u, Eigen::VectorXd& gradient) {
   last_ = distributed_ != nullptr ? distributed_->evaluate(system_, &gradient_)
                                   : system_.evaluate(&gradient_);
   ++evaluations_;
-  const bool loaded = load_origin_.size() != 0;
-  if (loaded) {
+  if (loaded_) {
     for (std::size_t k = 0; k < load_nodes_.size(); ++k) {
       gradient_.col(load_nodes_[k]) += load_columns_.col(static_cast<Eigen::Index>(k));
     }
   }
   map_.reduce_divided(gradient_, e0_, gradient);
-  return last_.potential / e0_ + (loaded ? load_reduced_.dot(u - load_origin_) : 0.0);
+  if (!loaded_) return last_.potential / e0_;
+  double load_work = 0.0;  // load . (u - u_ref), over the load's nonzero components in order
+  for (const ReducedLoad& l : load_reduced_) load_work += l.value * (u.coeff(l.dof) - l.origin);
+  return last_.potential / e0_ + load_work;
 }
 
 void Objective::set_load(const Eigen::Matrix3Xd& load, const Eigen::VectorXd& u_ref) {
@@ -85,15 +87,20 @@ void Objective::set_load(const Eigen::Matrix3Xd& load, const Eigen::VectorXd& u_
   for (std::size_t k = 0; k < load_nodes_.size(); ++k) {
     load_columns_.col(static_cast<Eigen::Index>(k)) = load.col(load_nodes_[k]);
   }
-  map_.reduce_divided(load, e0_, load_reduced_);
-  load_origin_ = u_ref;
+  Eigen::VectorXd reduced;  // for the moment of this call only
+  map_.reduce_divided(load, e0_, reduced);
+  load_reduced_.clear();
+  for (Eigen::Index k = 0; k < reduced.size(); ++k) {
+    if (reduced[k] != 0.0) load_reduced_.push_back({k, reduced[k], u_ref[k]});
+  }
+  loaded_ = true;
 }
 
 void Objective::clear_load() {
   load_nodes_.clear();
   load_columns_.resize(3, 0);
-  load_reduced_.resize(0);
-  load_origin_.resize(0);
+  load_reduced_.clear();
+  loaded_ = false;
 }
 
 }  // namespace mresim::mess::detail

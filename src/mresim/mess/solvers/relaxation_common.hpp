@@ -76,10 +76,18 @@ class Objective {
   template <class Dofs>
   double evaluate_here(const Dofs& u, Eigen::VectorXd& gradient);
 
-  std::vector<std::int32_t> load_nodes_;  // the nodes with a nonzero load
-  Eigen::Matrix3Xd load_columns_;         // their load (J/m)
-  Eigen::VectorXd load_reduced_;          // the load on the free variables, scaled
-  Eigen::VectorXd load_origin_;           // u_ref; empty without a load
+  // The load is nonzero on a few nodes (the particles'), so it is kept there only: a full
+  // copy of the load, of its reduced form and of u_ref would add 72 bytes per node to a
+  // correction pass's peak memory.
+  struct ReducedLoad {
+    Eigen::Index dof;  // a free variable the load acts on
+    double value;      // the load on it, scaled
+    double origin;     // u_ref there
+  };
+  bool loaded_ = false;
+  std::vector<std::int32_t> load_nodes_;   // the nodes with a nonzero load
+  Eigen::Matrix3Xd load_columns_;          // their load (J/m)
+  std::vector<ReducedLoad> load_reduced_;  // the nonzero load components on the free variables
 };
 
 }  // namespace mresim::mess::detail
