@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -96,4 +97,23 @@ TEST(MessMinimiser, LeavesTheSystemSettingsWhenAnEvaluationThrows) {
   opt.coupling = mess::MagnetizationCoupling::alternating;
   EXPECT_THROW((void)mess::minimise(sys, opt), std::invalid_argument);
   expect_same_settings(sys.settings(), before, "after the exception");
+}
+
+// The correction passes' forcing term must leave each pass a reduction to make: [0, 1).
+TEST(MessMinimiser, RefusesACorrectionForcingOutsideZeroToOne) {
+  for (const double forcing : {-0.1, 1.0, 2.0, std::nan("")}) {
+    mess::MinimiserOptions opt;
+    opt.correction_forcing = forcing;
+    try {
+      opt.validate();
+      ADD_FAILURE() << "accepted correction_forcing = " << forcing;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("correction_forcing must be in [0, 1)"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  mess::MinimiserOptions opt;
+  opt.correction_forcing = 0.0;  // the exact passes
+  EXPECT_NO_THROW(opt.validate());
 }

@@ -57,6 +57,9 @@ void MinimiserOptions::validate() const {
   if (max_outer_iterations < 1) fail("max_outer_iterations must be >= 1");
   if (lbfgs_memory < 1) fail("lbfgs_memory must be >= 1");
   if (!(max_step > 0.0)) fail("max_step must be > 0");
+  if (!(correction_forcing >= 0.0 && correction_forcing < 1.0)) {
+    fail("correction_forcing must be in [0, 1)");
+  }
   if (newton.max_krylov_iterations < 1) fail("newton.max_krylov_iterations must be >= 1");
   if (!(newton.forcing_max > 0.0 && newton.forcing_max < 1.0)) {
     fail("newton.forcing_max must be in (0, 1)");
@@ -327,6 +330,9 @@ class Minimisation {
     conservative_phase_ =
         method_ != MinimiserMethod::fire && caller_centre_rule() == CentreRule::centre_voxel;
     if (conservative_phase_) rules_.set_centre_rule(CentreRule::all_nodes);
+    if (conservative_phase_ && method_ == MinimiserMethod::lbfgs && opt_.correction_forcing > 0) {
+      set_inner_tolerance(force_difference_at_start());
+    }
     for (int outer = 0; outer < opt_.max_outer_iterations && budget_ > 0; ++outer) {
       if (!outer_iteration()) break;
     }
@@ -366,14 +372,47 @@ class Minimisation {
     return measure_.max_force(f_.full_gradient()) <= opt_.force_tolerance * force_scale_;
   }
 
-  // The inner minimisations' convergence test; also what the observer is shown.
+  // The inner minimisations' convergence test; also what the observer is shown. A loose
+  // inner run (set_inner_tolerance) tests the force alone.
   bool converged(double energy_change) {
     const double max_force = measure_.max_force(f_.full_gradient());
     if (opt_.observer) opt_.observer({++convergence_checks_, max_force});
+    if (!inner_tight_) return max_force <= inner_force_tolerance_ * force_scale_;
     // Energy change relative to the potential's size, but never below the energy scale E0:
     // tiny energies (a block at 1e-4 strain) are dominated by their own rounding noise.
     return max_force <= opt_.force_tolerance * force_scale_ &&
            std::abs(energy_change) <= opt_.energy_tolerance * std::max(f_.magnitude(), 1.0);
+  }
+
+  // The seed's L-BFGS route (the conservative phase and the correction passes) as inexact
+  // defect correction: an inner run need only resolve its objective well below what the next
+  // pass's frozen load will correct anyway (`to_correct`, N: the seed's force at a pass's
+  // start, the seed-neighbour force difference for the conservative phase); resolving it
+  // further is spent twice. Its force tolerance is correction_forcing x to_correct, never below
+  // force_tolerance (then with the energy test too: the run that may end the relaxation is a
+  // tight one).
+  void set_inner_tolerance(double to_correct) {
+    const double loose = opt_.correction_forcing * to_correct / force_scale_;
+    inner_tight_ = !(loose > opt_.force_tolerance);
+    inner_force_tolerance_ = inner_tight_ ? opt_.force_tolerance : loose;
+  }
+  // The largest difference between the seed's forces and its conservative neighbour's at the
+  // starting state (N): what the first correction pass will have to correct, so what the
+  // conservative phase need resolve. (Not the seed's force itself: after a field step that is
+  // the whole new magnetic force, and a phase ended at a fraction of it may stop halfway
+  // through a snap into contact, in another basin.)
+  double force_difference_at_start() {
+    rules_.set_centre_rule(caller_centre_rule());
+    evaluate_here();
+    Eigen::Matrix3Xd difference = f_.full_gradient();
+    rules_.set_centre_rule(CentreRule::all_nodes);
+    evaluate_here();
+    difference -= f_.full_gradient();
+    return measure_.max_force(difference);
+  }
+  void set_tight_inner_tolerance() {
+    inner_tight_ = true;
+    inner_force_tolerance_ = opt_.force_tolerance;
   }
 
   InnerResult run_inner() {
@@ -472,12 +511,15 @@ class Minimisation {
     conservative_phase_ = false;
     rules_.set_centre_rule(caller_centre_rule());
     evaluate_here();
-    if (status == MinimiserStatus::converged && forces_below_tolerance()) return false;
+    if (status == MinimiserStatus::converged && inner_tight_ && forces_below_tolerance()) {
+      return false;
+    }
     res_.forces_only_phase = true;
     if (status == MinimiserStatus::converged && method_ == MinimiserMethod::lbfgs) {
       correcting_ = true;  // the next outer iterations are correction passes
       return true;
     }
+    set_tight_inner_tolerance();
     use_energy_ = false;
     res_.slope_only_fallback = method_ == MinimiserMethod::lbfgs;
     return true;
@@ -491,19 +533,23 @@ class Minimisation {
   // constant load delta(x_k) . x: a true potential, so the energy line search works, and the
   // L-BFGS pairs of the conservative phase and of the passes before stay valid (a constant
   // load leaves the Hessian as it was). The pass's minimum has g_seed = delta(x) - delta(x_k),
-  // a factor 3e-3 (apart) to 0.07 (in contact) below the seed's force at x_k; the passes
-  // repeat until the seed's own forces meet the tolerance. Where L-BFGS on the seed's forces
-  // with the slope-only line search stalled in contact at full size and FIRE had to finish,
+  // a factor 3e-3 (apart) to 0.07 (in contact) below the seed's force at x_k; each pass is
+  // run only to correction_forcing x that force (set_inner_tolerance), and the passes repeat
+  // until the seed's own forces meet the tolerance after a tight one. Where L-BFGS on the seed's
+  // forces with the slope-only line search stalled in contact at full size and FIRE had to finish,
   // the passes converge (docs/performance.md). False: the seed's forces meet the tolerance.
   bool begin_correction_pass() {
     f_.clear_load();
     rules_.set_centre_rule(caller_centre_rule());
     evaluate_here();
     const double seed_force = measure_.max_force(f_.full_gradient());
-    if (seed_force <= opt_.force_tolerance * force_scale_) {
+    // Done once the seed's forces meet the tolerance after a tight pass (a loose one has not
+    // been tested on the energy change).
+    if (inner_tight_ && seed_force <= opt_.force_tolerance * force_scale_) {
       res_.status = MinimiserStatus::converged;
       return false;
     }
+    set_inner_tolerance(seed_force);
     Eigen::Matrix3Xd load = f_.full_gradient();  // the seed's gradient at x_k
     rules_.set_centre_rule(CentreRule::all_nodes);
     evaluate_here();
@@ -523,6 +569,7 @@ class Minimisation {
     correcting_ = false;
     f_.clear_load();
     rules_.set_centre_rule(caller_centre_rule());
+    set_tight_inner_tolerance();
     if (status == MinimiserStatus::max_iterations && budget_ <= 0) return false;
     use_energy_ = false;
     res_.slope_only_fallback = true;
@@ -547,6 +594,10 @@ class Minimisation {
   bool use_energy_ = true;
   bool conservative_phase_ = false;
   bool correcting_ = false;  // the seed's correction passes (begin_correction_pass)
+  // The current inner run's force tolerance (units of force_scale) and whether it is the
+  // caller's, with the energy test (set_inner_tolerance).
+  double inner_force_tolerance_ = opt_.force_tolerance;
+  bool inner_tight_ = true;
   int correction_passes_ = 0;
   static constexpr int kMaxCorrectionPasses = 20;
   LbfgsMemory lbfgs_memory_;  // kept from one inner run to the next only by the passes
