@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include "mresim/config/evenly_spaced.hpp"
+
 // Moved unchanged from run_file/read_mess_spec.cpp (the error messages of the [strain] and
 // [stress] tables are those of tests/bad_input/ and tests/mess/run_file/*errors*).
 
@@ -101,11 +103,7 @@ std::vector<double> read_load_values(const TableReader& t, const Range& max_rang
                        "(integer >= 1)",
                        t.path(), t.path()));
   }
-  std::vector<double> out;
-  for (long i = 0; i <= steps; ++i) {
-    out.push_back(*max * static_cast<double>(i) / static_cast<double>(steps));
-  }
-  return out;
+  return config::evenly_spaced_from_zero(*max, steps);
 }
 
 LoadKind parse_kind(const std::string& name) {

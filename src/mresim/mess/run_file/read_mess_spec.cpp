@@ -10,6 +10,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "mresim/config/evenly_spaced.hpp"
 #include "mresim/core/constants.hpp"
 #include "mresim/mess/lattice/stiffness.hpp"
 #include "mresim/mess/protocols/protocol.hpp"
@@ -500,9 +501,7 @@ void read_field(const TableReader& root, FieldSequence default_sequence, FieldSp
     f.form = FieldSpec::Form::max_and_steps;
     f.max = *max;
     f.steps = steps;
-    for (long i = 0; i <= steps; ++i) {
-      f.magnitudes.push_back(*max * static_cast<double>(i) / static_cast<double>(steps));
-    }
+    f.magnitudes = config::evenly_spaced_from_zero(*max, steps);
   } else {
     f.form = FieldSpec::Form::magnitudes;
     f.magnitudes = *magnitudes;
