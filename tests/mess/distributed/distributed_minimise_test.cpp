@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <memory>
 #include <vector>
@@ -20,6 +21,7 @@
 #include "mresim/mess/profile/model_profile.hpp"
 #include "mresim/mess/solvers/amg_preconditioner.hpp"
 #include "mresim/mess/solvers/minimiser.hpp"
+#include "mresim/mess/system/fixed_order.hpp"
 
 namespace mess = mresim::mess;
 namespace lat = mresim::lattice;
@@ -30,11 +32,13 @@ using mess::testing::world_rank;
 
 namespace {
 
-// Two n_d = 1 particles of the seed profile at 50 mT along z, every face held.
-mess::MessSystem held_pair() {
+// Two n_d = 1 particles of the seed profile at 50 mT along z, every face held. The default
+// lattice has one kSumBlock block of free coordinates (1,260), the larger one three (8,349).
+mess::MessSystem held_pair(std::array<int, 3> cells = {6, 7, 10},
+                           std::vector<std::array<int, 3>> centres = {{2, 3, 2}, {3, 3, 6}}) {
   const mess::ModelProfile profile = mess::model_profile("seed");
-  mess::MessSystem system = mess::MessSystem::make(
-      small_lattice(profile, {6, 7, 10}, {{2, 3, 2}, {3, 3, 6}}), tesla(0.0, 0.01, 0.05), profile);
+  mess::MessSystem system = mess::MessSystem::make(small_lattice(profile, cells, centres),
+                                                   tesla(0.0, 0.01, 0.05), profile);
   mess::BoundaryConstraints held = mess::BoundaryConstraints::none(system.node_count());
   for (const lat::Face f : {lat::Face::left, lat::Face::right, lat::Face::front, lat::Face::back,
                             lat::Face::bottom, lat::Face::top}) {
@@ -66,6 +70,25 @@ TEST(DistributedMinimise, RelaxesToTheSingleProcessStateBitwise) {
   double potential = b.final.potential;
   MPI_Bcast(&potential, 1, MPI_DOUBLE, 0, MPI_COMM_WORLD);
   EXPECT_TRUE(everywhere(potential == b.final.potential));
+}
+
+// The L-BFGS pairs split over the processes (each stores its own blocks) with the evaluations.
+TEST(DistributedMinimise, RelaxesALatticeOfSeveralBlocksToTheSingleProcessStateBitwise) {
+  mess::MessSystem single = held_pair({12, 12, 24}, {{5, 6, 8}, {6, 6, 14}});
+  const auto& shape = single.lattice().shape;
+  const long free_coordinates = 3L * (shape.nx() - 2) * (shape.ny() - 2) * (shape.nz() - 2);
+  ASSERT_GT(free_coordinates, 2 * mess::detail::kSumBlock);
+  mess::MessSystem split = single;
+  const mess::MinimiserResult a = mess::minimise(single);
+  mess::MinimiserOptions options;
+  options.distributed = std::make_shared<mess::DistributedEvaluator>(MPI_COMM_WORLD);
+  const mess::MinimiserResult b = mess::minimise(split, options);
+  ASSERT_TRUE(a.converged) << mess::to_string(a.status);
+  EXPECT_TRUE(everywhere(b.converged)) << mess::to_string(b.status);
+  EXPECT_EQ(a.evaluations, b.evaluations);
+  EXPECT_TRUE(everywhere(split.positions() == single.positions()))
+      << "largest difference " << (split.positions() - single.positions()).cwiseAbs().maxCoeff();
+  EXPECT_TRUE(everywhere(split.magnetizations() == single.magnetizations()));
 }
 
 TEST(DistributedMinimise, NewtonIsRefused) {

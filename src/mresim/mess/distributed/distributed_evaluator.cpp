@@ -2,11 +2,15 @@
 
 #include "mresim/mess/distributed/distributed_system.hpp"
 #include "mresim/mess/distributed/lattice_decomposition.hpp"
+#include "mresim/mess/distributed/mpi_block_split.hpp"
 #include "mresim/mess/solvers/amg_preconditioner.hpp"
 
 namespace mresim::mess {
 
-DistributedEvaluator::DistributedEvaluator(MPI_Comm comm) : comm_(comm) { initialise_petsc(); }
+DistributedEvaluator::DistributedEvaluator(MPI_Comm comm) : comm_(comm) {
+  initialise_petsc();
+  split_ = std::make_shared<MpiBlockSplit>(comm_);
+}
 
 DistributedEvaluator::~DistributedEvaluator() {
   (void)VecDestroy(&positions_);

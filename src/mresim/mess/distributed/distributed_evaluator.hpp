@@ -8,15 +8,17 @@
 // the energies agree with it to rounding and are bitwise the same on every process, so every
 // process's minimiser takes the same decisions.
 //
-// The positions, the gradient and the minimiser's vectors are not distributed (each process
-// holds them whole); the evaluation, most of a relaxation's work, is. docs/mpi.md has what
-// distributing the rest takes.
+// The positions and the gradient are not distributed (each process holds them whole); the
+// evaluation, most of a relaxation's work, is, and so are L-BFGS's stored pairs and its two-loop
+// recursion (vector_split(), solvers/lbfgs_memory.hpp). docs/mpi.md has what distributing the
+// rest takes.
 
 #include <petscvec.h>  // with MPI's header, without its C++ bindings
 
 #include <Eigen/Core>
 #include <memory>
 
+#include "mresim/mess/solvers/block_split.hpp"
 #include "mresim/mess/system/system_energy.hpp"
 
 namespace mresim::mess {
@@ -40,10 +42,15 @@ class DistributedEvaluator {
 
   [[nodiscard]] MPI_Comm comm() const { return comm_; }
 
+  // How the minimiser's free-coordinate vectors are shared among these processes
+  // (distributed/mpi_block_split.hpp); the same object on every call.
+  [[nodiscard]] std::shared_ptr<const detail::BlockSplit> vector_split() const { return split_; }
+
  private:
   void bind(MessSystem& system);
 
   MPI_Comm comm_;
+  std::shared_ptr<const detail::BlockSplit> split_;
   const MessSystem* bound_ = nullptr;
   std::int64_t bound_nodes_ = 0;
   std::unique_ptr<LatticeDecomposition> decomposition_;

@@ -12,10 +12,18 @@
 // update fused with the next dot product: 2m + 1 sweeps over q instead of 4m, bitwise the same
 // result for any number of threads. H0's scale needs P y of the newest pair: it is computed once
 // per new pair (or after forget_scale(), when P may have changed), not on every product.
+//
+// Over MPI processes (set_split, docs/mpi.md) each process stores only its own blocks of s and
+// y, about 1/P of the memory, and sweeps only those in the recursion; each dot product's block
+// sums are shared (BlockSplit) and added in block order, and q is shared whole before P is
+// applied and at the end. The product is then bitwise the single-process one, on every process.
 
 #include <Eigen/Core>
 #include <deque>
 #include <functional>
+#include <memory>
+
+#include "mresim/mess/solvers/block_split.hpp"
 
 namespace mresim::mess::detail {
 
@@ -29,6 +37,12 @@ class LbfgsMemory {
   // The preconditioner may have changed (a new inner run): H0's scale is computed again.
   void forget_scale() { scale_known_ = false; }
 
+  // Keep only this process's blocks from now on (null: the whole vectors); clears the memory.
+  // Every process of the split must then make the same calls with the same whole vectors.
+  void set_split(std::shared_ptr<const BlockSplit> split);
+  // Entries held in the stored pairs (2 x size() x the owned length).
+  [[nodiscard]] Eigen::Index stored_entries() const;
+
   // Keeps the pair s = alpha d, y = g_new - g_old if it has positive curvature
   // (s.y > 1e-12 |y|^2), dropping the oldest pairs beyond `capacity`.
   void add(double alpha, const Eigen::VectorXd& d, const Eigen::VectorXd& g_new,
@@ -39,12 +53,23 @@ class LbfgsMemory {
 
  private:
   void drop_oldest();
+  [[nodiscard]] OwnedBlocks owned(Eigen::Index n) const;
+  // sum over all blocks b of block(begin_b, length_b), each process computing its own blocks'
+  // terms (block(...) sees global indices), added in block order.
+  template <class Block>
+  double sum_owned(Eigen::Index n, Block&& block) const;
+  // The stored slice of v for the global entries [begin, begin + length).
+  auto at(const Eigen::VectorXd& v, Eigen::Index begin, Eigen::Index length) const {
+    return v.segment(begin - offset_, length);
+  }
 
   std::deque<Eigen::VectorXd> S_;
   std::deque<Eigen::VectorXd> Y_;
   std::deque<double> rho_;  // 1 / (s.y)
   double scale_ = 1.0;      // s.y / y.P y of the newest pair, once scale_known_
   bool scale_known_ = false;
+  std::shared_ptr<const BlockSplit> split_;
+  Eigen::Index offset_ = 0;  // global index of the stored vectors' first entry
 };
 
 }  // namespace mresim::mess::detail

@@ -8,6 +8,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "mresim/mess/distributed/distributed_evaluator.hpp"
 #include "mresim/mess/solvers/lbfgs_memory.hpp"
 #include "mresim/mess/solvers/leapfrog.hpp"
 #include "mresim/mess/solvers/line_search.hpp"
@@ -318,6 +319,10 @@ class Minimisation {
     if (options.precondition && options.method != MinimiserMethod::fire &&
         options.lbfgs_preconditioner == LbfgsPreconditioner::rigid_particles) {
       preconditioner_ = std::make_unique<RigidParticlePreconditioner>(system, map, force_scale);
+    }
+    // Over MPI processes each keeps only its blocks of the L-BFGS pairs (docs/mpi.md).
+    if (options.distributed != nullptr) {
+      lbfgs_memory_.set_split(options.distributed->vector_split());
     }
     res_.force_scale = force_scale;
   }
