@@ -5,7 +5,9 @@
 // (max force 1e-6 k_eff l_e). Prints per size and method: nodes, wall and CPU time, outer
 // iterations (Newton or L-BFGS steps), inner iterations (CG), evaluations, and the agreement
 // of the final states; then the exponent p of time ~ N^p fitted over n_d = 2 ... 5 and the
-// time ratios lbfgs / newton measured in this run. Methods: newton, lbfgs (the default),
+// time ratios measured in this run. Methods: newton, lbfgs (rigid-particle preconditioner:
+// run files' method = "lbfgs"), minimiser (the same L-BFGS with the multilevel preconditioner,
+// LbfgsPreconditioner::multilevel: the run files' default above kMultilevelMinimumNodes),
 // lbfgs-mg (L-BFGS with Newton's multigrid as its initial inverse Hessian,
 // LbfgsPreconditioner::multigrid) and, for the seed profile, lbfgs-exact (its correction passes
 // each resolved to the force tolerance: MinimiserOptions::correction_forcing = 0, against the
@@ -142,6 +144,7 @@ void print_against(const char* method, const Outcome& o, const char* reference_n
 Outcome relax_loop(const mess::ModelProfile& profile, int order, double correction_forcing) {
   mess::MessSystem sys = make_system(profile, order);
   mess::MinimiserOptions options;
+  options.lbfgs_preconditioner = mess::LbfgsPreconditioner::rigid_particles;  // "lbfgs"
   options.correction_forcing = correction_forcing;
   Outcome o;
   const auto start = std::chrono::steady_clock::now();
@@ -232,6 +235,7 @@ int main(int argc, char** argv) {
   std::vector<double> nodes_fit;
   std::vector<double> newton_fit;
   std::vector<double> lbfgs_fit;
+  std::vector<double> minimiser_fit;
   std::vector<double> multigrid_lbfgs_fit;
   for (const int order : orders) {
     const std::int64_t nodes = make_system(profile, order).node_count();
@@ -242,6 +246,11 @@ int main(int argc, char** argv) {
       print(order, nodes, "lbfgs", l);
       print_against("lbfgs", l, "newton", n);
       if (order >= 2) lbfgs_fit.push_back(l.wall);
+      const Outcome ml = relax(profile, order, mess::MinimiserMethod::lbfgs,
+                               mess::LbfgsPreconditioner::multilevel);
+      print(order, nodes, "minimiser", ml);
+      print_against("minimiser", ml, "lbfgs", l);
+      if (order >= 2) minimiser_fit.push_back(ml.wall);
       if (profile_name == "seed") {  // only the seed profile has correction passes
         const Outcome e = relax(profile, order, mess::MinimiserMethod::lbfgs,
                                 mess::LbfgsPreconditioner::rigid_particles, 0.0);
@@ -265,6 +274,9 @@ int main(int argc, char** argv) {
     std::printf("time ~ N^p over n_d >= 2: newton p = %.2f", exponent(nodes_fit, newton_fit));
     if (lbfgs_fit.size() == nodes_fit.size()) {
       std::printf(", lbfgs p = %.2f", exponent(nodes_fit, lbfgs_fit));
+    }
+    if (minimiser_fit.size() == nodes_fit.size()) {
+      std::printf(", minimiser p = %.2f", exponent(nodes_fit, minimiser_fit));
     }
     if (multigrid_lbfgs_fit.size() == nodes_fit.size()) {
       std::printf(", lbfgs-mg p = %.2f", exponent(nodes_fit, multigrid_lbfgs_fit));

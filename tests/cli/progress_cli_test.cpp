@@ -139,7 +139,7 @@ TEST(ProgressCli, ThreeDStepLinesSurviveSigterm) {
 
   const std::string err = read_text(dir / ".stderr");
   EXPECT_NE(err.find("mresim: lattice 10 x 10 x 18 nodes (1800 nodes, 2 particles), 501 steps, "
-                     "solver lbfgs, memory estimate "),
+                     "solver minimiser, memory estimate "),
             std::string::npos)
       << err;
   EXPECT_NE(err.find("mess_hysteresis: step 1/501 (B 0 T): "), std::string::npos) << err;

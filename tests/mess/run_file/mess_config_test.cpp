@@ -289,7 +289,7 @@ TEST(MessConfigSystems, Defaults) {
   EXPECT_EQ(s.field.theta_deg, 0.0);
   EXPECT_EQ(s.field.phi_deg, 0.0);
   EXPECT_EQ(s.field.sequence, FieldSequence::loop);
-  EXPECT_EQ(s.solver.method, SolverMethod::lbfgs);
+  EXPECT_EQ(s.solver.method, SolverMethod::minimiser);
   EXPECT_EQ(s.solver.minimiser.force_tolerance, 1e-6);
   // M solved tightly by default, for every profile (docs/magnetization-3d.md).
   EXPECT_EQ(s.solver.magnetization.atol, 1e-12);

@@ -11,6 +11,7 @@
 #include "mresim/mess/protocols/protocol.hpp"
 #include "mresim/mess/solvers/leapfrog.hpp"
 #include "mresim/mess/solvers/minimiser.hpp"
+#include "mresim/mess/solvers/preconditioner.hpp"
 
 namespace mresim::mess_protocol {
 
@@ -110,6 +111,13 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
       options.method = mess::MinimiserMethod::newton;
       options.newton_cache = newton_cache_;  // one multigrid for the run's steps
     }
+    // "minimiser": L-BFGS with the multilevel preconditioner on large lattices
+    // (LbfgsPreconditioner::automatic); "lbfgs" (and newton's L-BFGS fallback): with the
+    // rigid-particle preconditioner alone.
+    options.lbfgs_preconditioner = spec_.solver.method == mc::SolverMethod::minimiser
+                                       ? mess::LbfgsPreconditioner::automatic
+                                       : mess::LbfgsPreconditioner::rigid_particles;
+    options.preconditioner_cache = preconditioner_cache_;  // one for the run's steps
     options.force_tolerance = spec_.solver.minimiser.force_tolerance;
     options.max_iterations = static_cast<int>(spec_.solver.minimiser.max_iterations);
     options.observer = observer_;

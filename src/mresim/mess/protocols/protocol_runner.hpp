@@ -28,6 +28,7 @@
 #include "mresim/mess/protocols/step_plan.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
 #include "mresim/mess/solvers/newton.hpp"
+#include "mresim/mess/solvers/preconditioner.hpp"
 #include "mresim/mess/solvers/relaxation_observer.hpp"
 #include "mresim/mess/system/system_energy.hpp"
 
@@ -120,6 +121,9 @@ class ProtocolRunner {
   mess::MessSystem system_;
   // solver.method = "newton": the multigrid, built at the first step and kept for the others.
   std::shared_ptr<mess::NewtonCache> newton_cache_ = std::make_shared<mess::NewtonCache>();
+  // L-BFGS's preconditioner, built at the first step and kept while the free coordinates stay.
+  std::shared_ptr<mess::PreconditionerCache> preconditioner_cache_ =
+      std::make_shared<mess::PreconditionerCache>();
   mess::RelaxationObserver observer_;
   std::shared_ptr<mess::DistributedEvaluator> distributed_;
 };

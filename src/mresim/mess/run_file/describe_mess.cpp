@@ -238,9 +238,13 @@ void describe_solver(const MessSpec& s, app::InfoReport& r) {
   const SolverSpec& v = s.solver;
   const std::string sec = "solver";
   if (v.method != SolverMethod::leapfrog) {
-    r.add_text(sec, "method", v.method == SolverMethod::newton ? "newton" : "lbfgs",
-               v.method == SolverMethod::newton ? "Newton-Krylov with algebraic multigrid"
-                                                : "preconditioned L-BFGS");
+    r.add_text(sec, "method",
+               v.method == SolverMethod::newton  ? "newton"
+               : v.method == SolverMethod::lbfgs ? "lbfgs"
+                                                 : "minimiser",
+               v.method == SolverMethod::newton  ? "Newton-Krylov with algebraic multigrid"
+               : v.method == SolverMethod::lbfgs ? "L-BFGS, rigid-particle preconditioner"
+                                                 : "L-BFGS, multilevel preconditioner");
     r.add(sec, "force_tolerance", v.minimiser.force_tolerance, "k_eff l_e",
           "largest net force on a free node");
     r.add_integer(sec, "max_iterations", v.minimiser.max_iterations);

@@ -125,7 +125,10 @@ struct StressSpec {
 // [solver] method: "lbfgs" (also spelt "minimiser", the default), "newton" (Newton-Krylov with
 // algebraic multigrid, for large lattices: docs/mess-solvers.md) or "leapfrog" (the seed's
 // damped dynamics).
-enum class SolverMethod { lbfgs, newton, leapfrog };
+// minimiser: L-BFGS with the multilevel preconditioner (the default); lbfgs: L-BFGS with the
+// rigid-particle preconditioner alone (the method before the multilevel one, kept to measure
+// against); newton: Newton-Krylov; leapfrog: the original's damped leapfrog.
+enum class SolverMethod { minimiser, lbfgs, newton, leapfrog };
 
 struct MinimiserSettings {
   // Converged when the largest net force on a free node is below force_tolerance * k_eff l_e
@@ -150,7 +153,7 @@ struct LeapfrogSettings {
 std::optional<double> leapfrog_stability_limit(int discretization_order);
 
 struct SolverSpec {
-  SolverMethod method = SolverMethod::lbfgs;
+  SolverMethod method = SolverMethod::minimiser;
   MinimiserSettings minimiser;
   LeapfrogSettings leapfrog;
   // atol, rtol, iteration budgets; `demagnetization` mirrors MessSpec::demagnetization.

@@ -535,7 +535,8 @@ void read_solver(const std::optional<TableReader>& solver, bool demagnetization,
       t.choice_or("method", "minimiser", {"minimiser", "lbfgs", "newton", "leapfrog"});
   s.method = method == "leapfrog" ? SolverMethod::leapfrog
              : method == "newton" ? SolverMethod::newton
-                                  : SolverMethod::lbfgs;
+             : method == "lbfgs"  ? SolverMethod::lbfgs
+                                  : SolverMethod::minimiser;
   // [solver.minimiser] holds the criteria of lbfgs and newton alike.
   const std::string other = method == "leapfrog" ? "minimiser" : "leapfrog";
   if (t.has(other)) {

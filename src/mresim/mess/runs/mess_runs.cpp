@@ -163,10 +163,12 @@ class MessPlan final : public app::RunPlan {
   // What splitting over processes does not support yet, as run-file errors naming the key.
   void refuse_what_cannot_split() const {
     const char* method = spec_.solver.method == mc::SolverMethod::newton ? "newton" : "leapfrog";
-    if (spec_.solver.method != mc::SolverMethod::lbfgs) {
+    if (spec_.solver.method != mc::SolverMethod::minimiser &&
+        spec_.solver.method != mc::SolverMethod::lbfgs) {
       throw config::ConfigError(fmt::format(
-          "solver.method = \"{}\": under mpirun with more than one process only \"lbfgs\" "
-          "splits a relaxation over the processes (docs/mpi.md); run this file without mpirun",
+          "solver.method = \"{}\": under mpirun with more than one process only \"minimiser\" "
+          "and \"lbfgs\" split a relaxation over the processes (docs/mpi.md); run this file "
+          "without mpirun",
           method));
     }
     for (const mess::TermSpec& term : spec_.terms) {
@@ -204,7 +206,8 @@ class MessPlan final : public app::RunPlan {
     };
     const char* method = spec_.solver.method == mc::SolverMethod::newton     ? "newton"
                          : spec_.solver.method == mc::SolverMethod::leapfrog ? "leapfrog"
-                                                                             : "lbfgs";
+                         : spec_.solver.method == mc::SolverMethod::lbfgs    ? "lbfgs"
+                                                                             : "minimiser";
     std::string line = fmt::format(
         "mresim: lattice {} x {} x {} nodes ({} nodes, {} particles), {} steps, solver {}, "
         "memory estimate {}",

@@ -317,8 +317,15 @@ class Minimisation {
         budget_(options.max_iterations),
         method_(options.method) {
     if (options.precondition && options.method != MinimiserMethod::fire &&
-        options.lbfgs_preconditioner == LbfgsPreconditioner::rigid_particles) {
-      preconditioner_ = std::make_unique<RigidParticlePreconditioner>(system, map, force_scale);
+        options.lbfgs_preconditioner != LbfgsPreconditioner::multigrid) {
+      const bool multilevel = options.lbfgs_preconditioner == LbfgsPreconditioner::multilevel ||
+                              (options.lbfgs_preconditioner == LbfgsPreconditioner::automatic &&
+                               system.node_count() >= kMultilevelMinimumNodes);
+      preconditioner_ =
+          options.preconditioner_cache != nullptr
+              ? options.preconditioner_cache->get(system, map, force_scale, multilevel)
+              : std::make_shared<const RigidParticlePreconditioner>(system, map, force_scale,
+                                                                    multilevel);
     }
     // Over MPI processes each keeps only its blocks of the L-BFGS pairs (docs/mpi.md).
     if (options.distributed != nullptr) {
@@ -590,7 +597,7 @@ class Minimisation {
   Objective f_;
   Eigen::VectorXd u_;
   const Eigen::VectorXd mass_;
-  std::unique_ptr<RigidParticlePreconditioner> preconditioner_;
+  std::shared_ptr<const RigidParticlePreconditioner> preconditioner_;
   std::unique_ptr<detail::NewtonSolver> newton_;
   MinimiserResult res_;
   bool alternating_;

@@ -67,14 +67,23 @@ namespace mresim::mess {
 
 enum class MinimiserMethod { lbfgs, fire, newton };
 // L-BFGS's initial inverse Hessian H0 = gamma P:
-//  rigid_particles: RigidParticlePreconditioner (preconditioner.hpp), the default;
+//  automatic (the default; run files' method = "minimiser"): multilevel for lattices of at
+//    least kMultilevelMinimumNodes nodes, else rigid_particles;
+//  multilevel: RigidParticlePreconditioner with its multilevel correction (preconditioner.hpp,
+//    multilevel_correction.hpp): L-BFGS's iterations nearly independent of the lattice's size,
+//    each about 20 % dearer; it pays from a few 10,000 nodes on (docs/performance.md);
+//  rigid_particles: RigidParticlePreconditioner alone (run files' method = "lbfgs");
 //  multigrid: Newton's preconditioner (newton.hpp: one GAMG V-cycle on the elastic Hessian
 //    with the contact term's Woodbury correction). Measured in docs/performance.md: L-BFGS's
 //    iterations stay at 58-93 from 5k to 49k nodes (not 218-2,236), but a V-cycle costs
 //    about 12 evaluations at 16k nodes and 46 at 285k (serial PETSc), so it beat the
 //    default only at 49k nodes (1.23x) and Newton nowhere. Kept to measure the route
 //    (mess_scaling_bench); not offered in run files.
-enum class LbfgsPreconditioner { rigid_particles, multigrid };
+enum class LbfgsPreconditioner { automatic, multilevel, rigid_particles, multigrid };
+// Where `automatic` turns to the multilevel preconditioner. mess_scaling_bench, one field step
+// of the same pair at five lattice sizes: multilevel/rigid_particles wall time 1.4x at 14,400
+// nodes, 1.06x at 26,496 and 0.75x at 48,600 (docs/performance.md).
+inline constexpr std::int64_t kMultilevelMinimumNodes = 40000;
 enum class MagnetizationCoupling { alternating, every_evaluation };
 // stalled: 50 L-BFGS iterations without a new smallest force or an energy decrease beyond
 // rounding (the tolerance is below what the configuration's rounding allows).
@@ -110,6 +119,7 @@ struct NewtonOptions {
 };
 
 struct NewtonCache;          // newton.hpp
+class PreconditionerCache;   // preconditioner.hpp
 class DistributedEvaluator;  // distributed/distributed_evaluator.hpp
 
 struct MinimiserOptions {
@@ -125,7 +135,10 @@ struct MinimiserOptions {
   int lbfgs_memory = 10;
   // L-BFGS only: initial inverse Hessian from `lbfgs_preconditioner` (false: the identity).
   bool precondition = true;
-  LbfgsPreconditioner lbfgs_preconditioner = LbfgsPreconditioner::rigid_particles;
+  LbfgsPreconditioner lbfgs_preconditioner = LbfgsPreconditioner::automatic;
+  // multilevel and rigid_particles: where the preconditioner is kept between calls (a caller
+  // relaxing many steps of one system keeps one; null: built anew in every call).
+  std::shared_ptr<PreconditionerCache> preconditioner_cache;
   double max_step = 0.2;  // largest coordinate change per iteration, in units of l_e
   // Seed profile, lbfgs: inexact defect correction. The conservative phase stops once its
   // largest force is below correction_forcing x the largest difference between the seed's and

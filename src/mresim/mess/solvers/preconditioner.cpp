@@ -2,14 +2,17 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/QR>
+#include <bit>
 #include <cmath>
+#include <stdexcept>
 
 #include "mresim/mess/solvers/vector_algebra.hpp"
 
 namespace mresim::mess {
 
 RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& system,
-                                                         const DofMap& map, double force_scale) {
+                                                         const DofMap& map, double force_scale,
+                                                         bool multilevel) {
   const lattice::Lattice& lat = system.lattice();
   const Eigen::Matrix3Xd& x0 = lat.positions;
   const double l_e = lat.element_length;
@@ -82,6 +85,14 @@ RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& syste
           Eigen::MatrixXd::Identity(3 * np, 6);
     blocks_.push_back(std::move(b));
   }
+  if (multilevel) {
+    try {
+      multilevel_ = std::make_unique<MultilevelCorrection>(
+          lat, system.settings().elastic.volume_force_factor, map, force_scale);
+    } catch (const std::runtime_error&) {
+      multilevel_.reset();  // nothing held: the coarse Hessian is singular (header)
+    }
+  }
 }
 
 Eigen::VectorXd RigidParticlePreconditioner::apply(const Eigen::VectorXd& v) const {
@@ -99,7 +110,57 @@ Eigen::VectorXd RigidParticlePreconditioner::apply(const Eigen::VectorXd& v) con
     const Eigen::VectorXd wp = internal + b.q * (t / rigid_stiffness_);
     for (Eigen::Index i = 0; i < m; ++i) w[b.dofs[static_cast<std::size_t>(i)]] = wp[i];
   }
+  if (multilevel_ != nullptr) multilevel_->add_to(v, w);
   return w;
+}
+
+namespace {
+
+// FNV-1a over what a preconditioner depends on besides the lattice.
+class Fingerprint {
+ public:
+  void add(std::uint64_t value) {
+    for (int byte = 0; byte < 8; ++byte) {
+      hash_ ^= (value >> (8 * byte)) & 0xffU;
+      hash_ *= 0x100000001b3ULL;
+    }
+  }
+  std::uint64_t value() const { return hash_; }
+
+ private:
+  std::uint64_t hash_ = 0xcbf29ce484222325ULL;
+};
+
+std::uint64_t preconditioner_key(const MessSystem& system, const DofMap& map, double force_scale,
+                                 bool multilevel) {
+  Fingerprint f;
+  f.add(multilevel ? 1U : 0U);
+  f.add(std::bit_cast<std::uint64_t>(force_scale));
+  f.add(std::bit_cast<std::uint64_t>(system.settings().elastic.volume_force_factor));
+  f.add(static_cast<std::uint64_t>(map.size()));
+  for (Eigen::Index k = 0; k < map.own_dofs(); ++k) {
+    f.add(static_cast<std::uint64_t>(map.coordinate_of(k)));
+  }
+  for (Eigen::Index g = 0; g < map.groups(); ++g) {
+    f.add(static_cast<std::uint64_t>(map.group_nodes(g).size()));
+    for (const std::int32_t n : map.group_nodes(g)) f.add(static_cast<std::uint64_t>(n));
+  }
+  return f.value();
+}
+
+}  // namespace
+
+std::shared_ptr<const RigidParticlePreconditioner> PreconditionerCache::get(
+    const MessSystem& system, const DofMap& map, double force_scale, bool multilevel) {
+  const std::uint64_t key = preconditioner_key(system, map, force_scale, multilevel);
+  if (kept_ == nullptr || lattice_ != &system.lattice() || key != key_) {
+    kept_ =
+        std::make_shared<const RigidParticlePreconditioner>(system, map, force_scale, multilevel);
+    lattice_ = &system.lattice();
+    key_ = key;
+    ++builds_;
+  }
+  return kept_;
 }
 
 }  // namespace mresim::mess

@@ -18,10 +18,21 @@
 // kappa l_e / 16 per cell at the node), Q an orthonormal basis of the particle's 6 rigid motions
 // (3 translations, 3 rotations about its centre) and h the mean polymer diagonal (the rigid
 // modes are resisted by the polymer alone). P is symmetric positive definite.
+//
+// With `multilevel`, P + C: the additive correction over coarse grids of the lattice
+// (multilevel_correction.hpp), which carries the polymer's long and middle waves that the
+// diagonal leaves slow. Also symmetric positive definite. Where the lattice holds no coordinate
+// (so C would be singular) it is left out.
+//
+// Everything here depends only on the lattice, the free coordinates and the force scale, so a
+// run relaxing many steps keeps one (PreconditionerCache) while its free coordinates stay.
 
 #include <Eigen/Core>
+#include <cstdint>
+#include <memory>
 #include <vector>
 
+#include "mresim/mess/solvers/multilevel_correction.hpp"
 #include "mresim/mess/system/constraints.hpp"
 #include "mresim/mess/system/system_energy.hpp"
 
@@ -31,10 +42,14 @@ class RigidParticlePreconditioner {
  public:
   // Diagonal from the lattice's springs and cells; scaled like the minimiser's variables
   // (gradient in units of force_scale per l_e): D_scaled = D l_e / force_scale.
-  RigidParticlePreconditioner(const MessSystem& system, const DofMap& map, double force_scale);
+  RigidParticlePreconditioner(const MessSystem& system, const DofMap& map, double force_scale,
+                              bool multilevel = false);
 
   // P v.
   Eigen::VectorXd apply(const Eigen::VectorXd& v) const;
+
+  // The multilevel correction, or null (not asked for, or nothing held).
+  const MultilevelCorrection* multilevel() const { return multilevel_.get(); }
 
  private:
   Eigen::VectorXd inverse_diagonal_;  // D^-1 (only the inverse is kept: 24 bytes per node)
@@ -44,6 +59,24 @@ class RigidParticlePreconditioner {
     Eigen::MatrixXd q;               // 3 n_p x 6, orthonormal
   };
   std::vector<Block> blocks_;
+  std::unique_ptr<MultilevelCorrection> multilevel_;
+};
+
+// A run's preconditioner, kept across its relaxations: rebuilt only when what it depends on
+// changes (the free coordinates and rigid groups, the force scale, the multilevel choice).
+class PreconditionerCache {
+ public:
+  // The preconditioner for these arguments: the kept one if they match it, else a new one.
+  std::shared_ptr<const RigidParticlePreconditioner> get(const MessSystem& system,
+                                                         const DofMap& map, double force_scale,
+                                                         bool multilevel);
+  int builds() const { return builds_; }
+
+ private:
+  std::shared_ptr<const RigidParticlePreconditioner> kept_;
+  const lattice::Lattice* lattice_ = nullptr;
+  std::uint64_t key_ = 0;
+  int builds_ = 0;
 };
 
 }  // namespace mresim::mess

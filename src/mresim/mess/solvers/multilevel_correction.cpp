@@ -1,0 +1,404 @@
+#include "mresim/mess/solvers/multilevel_correction.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace mresim::mess {
+
+namespace {
+
+// Grid fields of 3-vectors are stored node by node, node index iz + nz (ix + nx iy), as the
+// lattice numbers its nodes (lattice/grid.hpp). dims = {nx, ny, nz}.
+using Dims = std::array<int, 3>;
+
+std::array<std::int64_t, 3> strides(const Dims& d) {
+  return {static_cast<std::int64_t>(d[2]), static_cast<std::int64_t>(d[2]) * d[0], 1};
+}
+
+std::int64_t point_count(const Dims& d) { return static_cast<std::int64_t>(d[0]) * d[1] * d[2]; }
+
+// Calls line(in_offset, out_offset) for every grid line along `axis`, in parallel: each line is
+// one thread's, so what a line computes does not depend on the number of threads.
+template <class Line>
+void for_each_line(const Dims& in, const Dims& out, int axis, Line&& line) {
+  const int b = axis == 0 ? 1 : 0;
+  const int c = axis == 2 ? 1 : 2;
+  const auto si = strides(in);
+  const auto so = strides(out);
+  const std::int64_t lines =
+      static_cast<std::int64_t>(in[static_cast<std::size_t>(b)]) * in[static_cast<std::size_t>(c)];
+#pragma omp parallel for schedule(static) if (lines * in[static_cast <std::size_t>(axis)] > 20000)
+  for (std::int64_t l = 0; l < lines; ++l) {
+    const std::int64_t ib = l / in[static_cast<std::size_t>(c)];
+    const std::int64_t ic = l % in[static_cast<std::size_t>(c)];
+    line(3 * (ib * si[static_cast<std::size_t>(b)] + ic * si[static_cast<std::size_t>(c)]),
+         3 * (ib * so[static_cast<std::size_t>(b)] + ic * so[static_cast<std::size_t>(c)]));
+  }
+}
+
+// Restricts a field of 3-vectors on the grid `dims` along `axis` to `level`'s points there:
+// out[j] = sum_i phi_j(i) in[i] over each grid line, in index order. read(c) gives the input at
+// flat index c = 3 node + component.
+template <class Level, class Read>
+void restrict_axis(Read&& read, const Dims& dims, int axis, const Level& level,
+                   Eigen::VectorXd& out) {
+  const auto& ax = level.axes[static_cast<std::size_t>(axis)];
+  Dims next = dims;
+  next[static_cast<std::size_t>(axis)] = level.points[static_cast<std::size_t>(axis)];
+  out.resize(3 * point_count(next));
+  const std::int64_t si = 3 * strides(dims)[static_cast<std::size_t>(axis)];
+  const std::int64_t so = 3 * strides(next)[static_cast<std::size_t>(axis)];
+  const int n_in = dims[static_cast<std::size_t>(axis)];
+  const int n_out = next[static_cast<std::size_t>(axis)];
+  for_each_line(dims, next, axis, [&](std::int64_t in_offset, std::int64_t out_offset) {
+    for (int j = 0; j < n_out; ++j) {
+      for (int a = 0; a < 3; ++a) out[out_offset + j * so + a] = 0.0;
+    }
+    for (int i = 0; i < n_in; ++i) {
+      const double t = ax.upper[static_cast<std::size_t>(i)];
+      const std::int64_t lo = out_offset + ax.lower[static_cast<std::size_t>(i)] * so;
+      for (int a = 0; a < 3; ++a) {
+        const double value = read(in_offset + i * si + a);
+        out[lo + a] += (1.0 - t) * value;
+        if (t != 0.0) out[lo + so + a] += t * value;
+      }
+    }
+  });
+}
+
+// The transpose: interpolates `in` (on `coarse` dims, `level`'s points along `axis`) to the
+// finer grid `fine` along `axis`; write(c, value) takes each fine value once.
+template <class Level, class Write>
+void interpolate_axis(const Eigen::VectorXd& in, const Dims& coarse, int axis, const Level& level,
+                      const Dims& fine, Write&& write) {
+  const auto& ax = level.axes[static_cast<std::size_t>(axis)];
+  const std::int64_t si = 3 * strides(coarse)[static_cast<std::size_t>(axis)];
+  const std::int64_t so = 3 * strides(fine)[static_cast<std::size_t>(axis)];
+  const int n_out = fine[static_cast<std::size_t>(axis)];
+  for_each_line(fine, coarse, axis, [&](std::int64_t out_offset, std::int64_t in_offset) {
+    for (int i = 0; i < n_out; ++i) {
+      const double t = ax.upper[static_cast<std::size_t>(i)];
+      const std::int64_t lo = in_offset + ax.lower[static_cast<std::size_t>(i)] * si;
+      for (int a = 0; a < 3; ++a) {
+        write(out_offset + i * so + a,
+              t == 0.0 ? in[lo + a] : (1.0 - t) * in[lo + a] + t * in[lo + si + a]);
+      }
+    }
+  });
+}
+
+auto vector_reader(const Eigen::VectorXd& v) {
+  return [&v](std::int64_t c) { return v[c]; };
+}
+
+// Writes into `v`, sized for the grid `dims`.
+auto vector_writer(Eigen::VectorXd& v, const Dims& dims) {
+  v.resize(3 * point_count(dims));
+  return [&v](std::int64_t c, double value) { v[c] = value; };
+}
+
+// One rank-one term's projection onto a level: per level node, the three axes' values.
+struct Entry {
+  std::int64_t node;
+  std::array<double, 3> value;
+};
+
+void add_entry(std::vector<Entry>& z, std::int64_t node, const std::array<double, 3>& value) {
+  for (Entry& e : z) {
+    if (e.node == node) {
+      for (std::size_t a = 0; a < 3; ++a) e.value[a] += value[a];
+      return;
+    }
+  }
+  z.push_back({node, value});
+}
+
+constexpr int kReach = 2;  // the coarsest level's couplings reach 2 points along each axis
+constexpr int kWidth = 2 * kReach + 1;
+constexpr int kNeighbours = kWidth * kWidth * kWidth;
+
+}  // namespace
+
+MultilevelCorrection::MultilevelCorrection(const lattice::Lattice& lattice,
+                                           double volume_force_factor, const DofMap& map,
+                                           double force_scale, Eigen::Index exact_limit) {
+  if (exact_limit < 1) {
+    throw std::invalid_argument("MultilevelCorrection: exact_limit " + std::to_string(exact_limit) +
+                                " must be at least 1");
+  }
+  fine_ = lattice.shape.nodes;
+  const std::int64_t nodes = lattice.node_count();
+  if (map.own_dofs() > std::numeric_limits<std::int32_t>::max()) {
+    throw std::invalid_argument("MultilevelCorrection: more than 2^31 free coordinates");
+  }
+  dof_of_coordinate_.assign(static_cast<std::size_t>(3 * nodes), -1);
+  for (Eigen::Index k = 0; k < map.own_dofs(); ++k) {
+    dof_of_coordinate_[static_cast<std::size_t>(map.coordinate_of(k))] =
+        static_cast<std::int32_t>(k);
+  }
+  build_levels(exact_limit);
+  assemble(lattice, volume_force_factor, lattice.element_length / force_scale);
+}
+
+Eigen::Index MultilevelCorrection::level_size(int level) const {
+  const Level& l = levels_.at(static_cast<std::size_t>(level - 1));
+  return 3 * point_count(l.points);
+}
+
+void MultilevelCorrection::build_levels(Eigen::Index exact_limit) {
+  std::array<std::vector<int>, 3> planes;
+  for (std::size_t a = 0; a < 3; ++a) {
+    planes[a].resize(static_cast<std::size_t>(fine_[a]));
+    for (int i = 0; i < fine_[a]; ++i) planes[a][static_cast<std::size_t>(i)] = i;
+  }
+  while (true) {
+    Level level;
+    bool coarser = false;
+    for (std::size_t a = 0; a < 3; ++a) {
+      const std::vector<int>& finer = planes[a];
+      Axis& axis = level.axes[a];
+      for (std::size_t i = 0; i < finer.size(); i += 2) axis.plane.push_back(finer[i]);
+      if (axis.plane.back() != finer.back()) axis.plane.push_back(finer.back());
+      coarser = coarser || axis.plane.size() < finer.size();
+      const auto m = static_cast<int>(axis.plane.size());
+      for (std::size_t i = 0; i < finer.size(); ++i) {
+        const int lower = std::min(static_cast<int>(i / 2), m - 2);
+        const double p0 = axis.plane[static_cast<std::size_t>(lower)];
+        const double p1 = axis.plane[static_cast<std::size_t>(lower + 1)];
+        axis.lower.push_back(lower);
+        axis.upper.push_back((finer[i] - p0) / (p1 - p0));
+      }
+      level.points[a] = m;
+    }
+    // A grid of two planes per axis cannot be coarsened: the previous level is the coarsest.
+    if (!coarser && !levels_.empty()) break;
+    for (std::size_t a = 0; a < 3; ++a) planes[a] = level.axes[a].plane;
+    levels_.push_back(std::move(level));
+    // The coarsest level is solved exactly at every application, so it must also be small
+    // against the lattice: at most 1/64 of its coordinates (two coarsenings where possible).
+    const std::int64_t size = 3 * point_count(levels_.back().points);
+    if (size <= exact_limit && 64 * size <= 3 * point_count(fine_)) break;
+  }
+}
+
+void MultilevelCorrection::assemble(const lattice::Lattice& lattice, double volume_force_factor,
+                                    double scale) {
+  const Eigen::Matrix3Xd& x0 = lattice.positions;
+  const double l_e = lattice.element_length;
+  const auto nz = static_cast<std::int64_t>(fine_[2]);
+  const auto nx = static_cast<std::int64_t>(fine_[0]);
+  for (std::size_t li = 0; li < levels_.size(); ++li) {
+    Level& level = levels_[li];
+    const bool exact = li + 1 == levels_.size();
+    const Dims& p = level.points;
+    const std::int64_t points = point_count(p);
+    // Each lattice plane's bracket on this level: the composition of the levels' linear
+    // interpolations is the linear interpolation in lattice coordinates (nested grids).
+    std::array<std::vector<int>, 3> lower;
+    std::array<std::vector<double>, 3> upper;
+    for (std::size_t a = 0; a < 3; ++a) {
+      const std::vector<int>& plane = level.axes[a].plane;
+      int j = 0;
+      for (int f = 0; f < fine_[a]; ++f) {
+        while (j + 2 < static_cast<int>(plane.size()) &&
+               plane[static_cast<std::size_t>(j + 1)] <= f)
+          ++j;
+        lower[a].push_back(j);
+        upper[a].push_back(
+            static_cast<double>(f - plane[static_cast<std::size_t>(j)]) /
+            (plane[static_cast<std::size_t>(j + 1)] - plane[static_cast<std::size_t>(j)]));
+      }
+    }
+    std::vector<Entry> z;
+    // z += sign direction_a phi_n for the free coordinates a of lattice node n.
+    const auto add_node = [&](std::int64_t n, const Eigen::Vector3d& direction, double sign) {
+      const std::array<std::int64_t, 3> i{(n / nz) % nx, n / nz / nx, n % nz};
+      for (int c = 0; c < 8; ++c) {
+        std::array<std::int64_t, 3> j{};
+        double w = sign;
+        for (std::size_t a = 0; a < 3; ++a) {
+          const bool up = ((c >> a) & 1) != 0;
+          const auto f = static_cast<std::size_t>(i[a]);
+          j[a] = lower[a][f] + (up ? 1 : 0);
+          w *= up ? upper[a][f] : 1.0 - upper[a][f];
+        }
+        if (w == 0.0) continue;
+        const std::int64_t node = j[2] + p[2] * (j[0] + static_cast<std::int64_t>(p[0]) * j[1]);
+        std::array<double, 3> value{};
+        for (std::size_t a = 0; a < 3; ++a) {
+          if (dof_of_coordinate_[static_cast<std::size_t>(3 * n) + a] >= 0) {
+            value[a] = w * direction[static_cast<Eigen::Index>(a)];
+          }
+        }
+        add_entry(z, node, value);
+      }
+    };
+    std::vector<double> diagonal(static_cast<std::size_t>(3 * points), 0.0);
+    std::vector<double> blocks;
+    if (exact) blocks.assign(static_cast<std::size_t>(points * kNeighbours * 9), 0.0);
+    const auto add_term = [&](double c) {
+      for (const Entry& e : z) {
+        for (std::size_t a = 0; a < 3; ++a) {
+          diagonal[static_cast<std::size_t>(3 * e.node) + a] += c * e.value[a] * e.value[a];
+        }
+      }
+      if (!exact) return;
+      for (const Entry& e : z) {
+        const std::array<std::int64_t, 3> je{(e.node / p[2]) % p[0], e.node / p[2] / p[0],
+                                             e.node % p[2]};
+        for (const Entry& f : z) {
+          const std::array<std::int64_t, 3> jf{(f.node / p[2]) % p[0], f.node / p[2] / p[0],
+                                               f.node % p[2]};
+          const std::int64_t code = (jf[0] - je[0] + kReach) * kWidth * kWidth +
+                                    (jf[1] - je[1] + kReach) * kWidth + (jf[2] - je[2] + kReach);
+          double* block = blocks.data() + (e.node * kNeighbours + code) * 9;
+          for (std::size_t a = 0; a < 3; ++a) {
+            for (std::size_t b = 0; b < 3; ++b) block[3 * a + b] += c * e.value[a] * f.value[b];
+          }
+        }
+      }
+    };
+    // Springs at rest: k e e^T on (x_j - x_i), e the rest direction (eq. 4.62's Hessian).
+    const lattice::SpringSet& sp = lattice.springs;
+    for (std::size_t s = 0; s < sp.size(); ++s) {
+      const std::int64_t i = sp.first[s];
+      const std::int64_t j = sp.second(s);
+      const Eigen::Vector3d e = (x0.col(j) - x0.col(i)).normalized();
+      z.clear();
+      add_node(j, e, 1.0);
+      add_node(i, e, -1.0);
+      add_term(sp.stiffness(s) * scale);
+    }
+    // Volume term at rest: f kappa g g^T / V0, g_a = +-l_e^2 / 4 at each vertex (as the
+    // diagonal of RigidParticlePreconditioner).
+    const double cell =
+        volume_force_factor * std::abs(lattice.polymer.kappa) / (l_e * l_e * l_e) * scale;
+    for (const auto& element : lattice.elements) {
+      Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+      for (const std::int32_t n : element) centre += x0.col(n);
+      centre /= 8.0;
+      z.clear();
+      for (const std::int32_t n : element) {
+        add_node(n, (x0.col(n) - centre).cwiseSign() * (l_e * l_e / 4.0), 1.0);
+      }
+      add_term(cell);
+    }
+
+    level.residual.resize(3 * points);
+    level.update.resize(3 * points);
+    if (!exact) {
+      level.inverse_diagonal = Eigen::VectorXd::Zero(3 * points);
+      for (std::int64_t q = 0; q < 3 * points; ++q) {
+        const double d = diagonal[static_cast<std::size_t>(q)];
+        if (d > 0.0) level.inverse_diagonal[q] = 1.0 / d;
+      }
+      continue;
+    }
+    exact_index_.assign(static_cast<std::size_t>(3 * points), -1);
+    Eigen::Index rows = 0;
+    for (std::size_t q = 0; q < diagonal.size(); ++q) {
+      if (diagonal[q] > 0.0) exact_index_[q] = rows++;
+    }
+    std::vector<Eigen::Triplet<double>> triplets;
+    for (std::int64_t e = 0; e < points; ++e) {
+      const std::array<std::int64_t, 3> je{(e / p[2]) % p[0], e / p[2] / p[0], e % p[2]};
+      for (int code = 0; code < kNeighbours; ++code) {
+        const std::array<std::int64_t, 3> jf{je[0] + code / (kWidth * kWidth) - kReach,
+                                             je[1] + (code / kWidth) % kWidth - kReach,
+                                             je[2] + code % kWidth - kReach};
+        if (jf[0] < 0 || jf[1] < 0 || jf[2] < 0 || jf[0] >= p[0] || jf[1] >= p[1] ||
+            jf[2] >= p[2]) {
+          continue;
+        }
+        const std::int64_t f = jf[2] + p[2] * (jf[0] + static_cast<std::int64_t>(p[0]) * jf[1]);
+        for (int a = 0; a < 3; ++a) {
+          const Eigen::Index row = exact_index_[static_cast<std::size_t>(3 * e + a)];
+          if (row < 0) continue;
+          for (int b = 0; b < 3; ++b) {
+            const Eigen::Index col = exact_index_[static_cast<std::size_t>(3 * f + b)];
+            const double value =
+                blocks[static_cast<std::size_t>((e * kNeighbours + code) * 9 + 3 * a + b)];
+            if (col >= 0 && value != 0.0) triplets.emplace_back(row, col, value);
+          }
+        }
+      }
+    }
+    Eigen::SparseMatrix<double> matrix(rows, rows);
+    matrix.setFromTriplets(triplets.begin(), triplets.end());
+    factor_.compute(matrix);
+    // Nothing held (or a rigid motion left free): A is singular and so is the coarsest matrix.
+    const Eigen::VectorXd pivots = factor_.vectorD();
+    if (factor_.info() != Eigen::Success || rows == 0 ||
+        !(pivots.minCoeff() > 1e-12 * pivots.maxCoeff())) {
+      throw std::runtime_error(
+          "MultilevelCorrection: the coarsest level's Hessian is singular (no rigid motion of "
+          "the lattice is held)");
+    }
+  }
+}
+
+void MultilevelCorrection::add_to(const Eigen::VectorXd& v, Eigen::VectorXd& w) const {
+  // The lattice field is v read through the coordinates' dofs (0 on held coordinates and rigid
+  // groups' nodes); the coarse fields are vectors.
+  const auto read_lattice = [&](std::int64_t coordinate) {
+    const std::int32_t k = dof_of_coordinate_[static_cast<std::size_t>(coordinate)];
+    return k >= 0 ? v[k] : 0.0;
+  };
+  Dims dims = fine_;
+  for (std::size_t li = 0; li < levels_.size(); ++li) {
+    const Level& level = levels_[li];
+    Eigen::VectorXd along_z;
+    if (li == 0) {
+      restrict_axis(read_lattice, dims, 2, level, along_z);
+    } else {
+      restrict_axis(vector_reader(levels_[li - 1].residual), dims, 2, level, along_z);
+    }
+    dims[2] = level.points[2];
+    Eigen::VectorXd along_x;
+    restrict_axis(vector_reader(along_z), dims, 0, level, along_x);
+    dims[0] = level.points[0];
+    restrict_axis(vector_reader(along_x), dims, 1, level, level.residual);
+    dims[1] = level.points[1];
+  }
+
+  const Level& coarsest = levels_.back();
+  Eigen::VectorXd compact(factor_.rows());
+  for (std::size_t q = 0; q < exact_index_.size(); ++q) {
+    if (exact_index_[q] >= 0)
+      compact[exact_index_[q]] = coarsest.residual[static_cast<Eigen::Index>(q)];
+  }
+  const Eigen::VectorXd solved = factor_.solve(compact);
+  for (std::size_t q = 0; q < exact_index_.size(); ++q) {
+    coarsest.update[static_cast<Eigen::Index>(q)] =
+        exact_index_[q] >= 0 ? solved[exact_index_[q]] : 0.0;
+  }
+  // Interpolation back, level by level (y, x, z); each finer level adds its own scaled part,
+  // and the lattice's free coordinates take the last sweep's values into w.
+  for (std::size_t li = levels_.size(); li-- > 0;) {
+    const Level& level = levels_[li];
+    const Dims finer = li == 0 ? fine_ : levels_[li - 1].points;
+    Dims d = level.points;
+    Eigen::VectorXd along_y;
+    d[1] = finer[1];
+    interpolate_axis(level.update, level.points, 1, level, d, vector_writer(along_y, d));
+    Eigen::VectorXd along_x;
+    Dims dx = d;
+    dx[0] = finer[0];
+    interpolate_axis(along_y, d, 0, level, dx, vector_writer(along_x, dx));
+    if (li > 0) {
+      const Level& next = levels_[li - 1];
+      interpolate_axis(along_x, dx, 2, level, finer, vector_writer(next.update, finer));
+      next.update += next.inverse_diagonal.cwiseProduct(next.residual);
+    } else {
+      interpolate_axis(along_x, dx, 2, level, finer, [&](std::int64_t coordinate, double value) {
+        const std::int32_t k = dof_of_coordinate_[static_cast<std::size_t>(coordinate)];
+        if (k >= 0) w[k] += value;
+      });
+    }
+  }
+}
+
+}  // namespace mresim::mess

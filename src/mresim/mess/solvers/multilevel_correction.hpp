@@ -1,0 +1,97 @@
+#pragma once
+
+// The multilevel part of the minimisers' preconditioner (preconditioner.hpp): an additive
+// correction over a hierarchy of coarse grids of the lattice (Bramble, Pasciak and Xu, "Parallel
+// multilevel preconditioners", Math. Comp. 55, 1990):
+//
+//   C v = sum_l Phi_l B_l Phi_l^T v,
+//
+// Phi_l the trilinear interpolation from coarse grid l to the free node coordinates, A the
+// elastic Hessian at the reference configuration (springs and volume term: the Hessian whose
+// diagonal RigidParticlePreconditioner inverts), B_l = diag(Phi_l^T A Phi_l)^-1 on every level
+// but the coarsest and B_L = (Phi_L^T A Phi_L)^-1 on the coarsest (a sparse LDL^T).
+//
+// Why. The rigid-particle preconditioner is a diagonal scaling plus the particles' rigid
+// motions, so the polymer's long and middle waves keep the conditioning of a diagonally scaled
+// Laplacian, which worsens like the lattice's width squared: L-BFGS's iterations grew with the
+// lattice (docs/performance.md). Each level carries the waves of its own length; the sum is
+// known to condition a grid Laplacian independently of the grid's size.
+//
+// The grids. Level 1 takes every second lattice plane along each axis and the last one, level
+// l + 1 every second plane of level l and its last one, so the grids are nested and Phi_l is
+// the composition of the levels' own linear interpolations. Coarsening stops at the first
+// level with at most `exact_limit` coarse coordinates, which is solved exactly.
+//
+// Cost. Applying C restricts v level by level (one sweep per axis, each halving the data; the
+// first reads v in place), scales, solves the coarsest level and interpolates back (the last
+// sweep adds into w): about a fifth of an energy evaluation at 285k nodes. The sweeps are split
+// over the threads by grid lines, so the result is bitwise the same for any number of threads.
+// Memory: a coordinate-to-dof map (12 bytes per node), the levels (about 10 bytes per node) and
+// the sweeps' transient arrays (18 bytes per node while C is applied). Building it sweeps the
+// lattice's springs and cells once per level (each term's Hessian has rank one at rest: k e e^T per
+// spring, f kappa g g^T / V0 per cell); the result depends only on the lattice, the free
+// coordinates and the force scale, so a run keeps it for all its steps (PreconditionerCache,
+// preconditioner.hpp).
+
+#include <Eigen/Core>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "mresim/mess/lattice/lattice.hpp"
+#include "mresim/mess/system/constraints.hpp"
+
+namespace mresim::mess {
+
+class MultilevelCorrection {
+ public:
+  static constexpr Eigen::Index kDefaultExactLimit = 4000;
+
+  // Scaled like the minimiser's variables (RigidParticlePreconditioner): A l_e / force_scale.
+  // `volume_force_factor`: the volume term's force factor (MessSettings::elastic).
+  // Throws std::invalid_argument if exact_limit < 1, std::runtime_error if the coarsest level
+  // cannot be factored (no coordinate held, so A is singular: callers leave the correction out).
+  MultilevelCorrection(const lattice::Lattice& lattice, double volume_force_factor,
+                       const DofMap& map, double force_scale,
+                       Eigen::Index exact_limit = kDefaultExactLimit);
+
+  // w += C v (v, w over the map's dofs).
+  void add_to(const Eigen::VectorXd& v, Eigen::VectorXd& w) const;
+
+  int levels() const { return static_cast<int>(levels_.size()); }
+  // Coarse coordinates of level l (1-based, as in the header): 3 x its grid points.
+  Eigen::Index level_size(int level) const;
+
+ private:
+  // One axis of a level: the lattice plane of each point, and for each point of the next finer
+  // level (the lattice for level 1) the lower of its two bracketing points here and the weight
+  // of the upper one.
+  struct Axis {
+    std::vector<int> plane;
+    std::vector<int> lower;
+    std::vector<double> upper;
+  };
+  struct Level {
+    std::array<Axis, 3> axes;
+    std::array<int, 3> points{};
+    // 3 x points: diag(Phi^T A Phi)^-1 (0 where no free coordinate reaches), coarsest: unused.
+    Eigen::VectorXd inverse_diagonal;
+    mutable Eigen::VectorXd residual;  // Phi_l^T v
+    mutable Eigen::VectorXd update;    // what level l hands to the finer level
+  };
+
+  void build_levels(Eigen::Index exact_limit);
+  void assemble(const lattice::Lattice& lattice, double volume_force_factor, double scale);
+
+  std::array<int, 3> fine_{};
+  // Flat coordinate 3 n + a -> its own dof, or -1 (held, or a rigid group's node): 12 bytes
+  // per node, the correction's only array over the lattice besides its transient sweeps.
+  std::vector<std::int32_t> dof_of_coordinate_;
+  std::vector<Level> levels_;
+  std::vector<Eigen::Index> exact_index_;  // coarsest level: 3 J + a -> row of the factor, or -1
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factor_;
+};
+
+}  // namespace mresim::mess
