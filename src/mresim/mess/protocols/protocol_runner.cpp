@@ -76,6 +76,26 @@ const SlotState* ProtocolRunner::start_state(const StepSpec& step,
   return &state.slots[slot_of_field(step.field_index - 1)];
 }
 
+mess::MinimiserOptions ProtocolRunner::minimiser_options() const {
+  mess::MinimiserOptions options;
+  if (spec_.solver.method == mc::SolverMethod::newton) {
+    options.method = mess::MinimiserMethod::newton;
+    options.newton_cache = newton_cache_;  // one multigrid for the run's steps
+  }
+  // "minimiser": L-BFGS with the multilevel preconditioner on large lattices
+  // (LbfgsPreconditioner::automatic); "lbfgs" (and newton's L-BFGS fallback): with the
+  // rigid-particle preconditioner alone.
+  options.lbfgs_preconditioner = spec_.solver.method == mc::SolverMethod::minimiser
+                                     ? mess::LbfgsPreconditioner::automatic
+                                     : mess::LbfgsPreconditioner::rigid_particles;
+  options.preconditioner_cache = preconditioner_cache_;  // one for the run's steps
+  options.force_tolerance = spec_.solver.minimiser.force_tolerance;
+  options.max_iterations = static_cast<int>(spec_.solver.minimiser.max_iterations);
+  options.observer = observer_;
+  options.distributed = distributed_;
+  return options;
+}
+
 const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   if (state.next_step >= steps_.size()) {
     throw std::logic_error("ProtocolRunner::run_next_step: no steps left");
@@ -106,23 +126,7 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   record.step = step;
   const double b = step.field.norm();
   if (spec_.solver.method != mc::SolverMethod::leapfrog) {
-    mess::MinimiserOptions options;
-    if (spec_.solver.method == mc::SolverMethod::newton) {
-      options.method = mess::MinimiserMethod::newton;
-      options.newton_cache = newton_cache_;  // one multigrid for the run's steps
-    }
-    // "minimiser": L-BFGS with the multilevel preconditioner on large lattices
-    // (LbfgsPreconditioner::automatic); "lbfgs" (and newton's L-BFGS fallback): with the
-    // rigid-particle preconditioner alone.
-    options.lbfgs_preconditioner = spec_.solver.method == mc::SolverMethod::minimiser
-                                       ? mess::LbfgsPreconditioner::automatic
-                                       : mess::LbfgsPreconditioner::rigid_particles;
-    options.preconditioner_cache = preconditioner_cache_;  // one for the run's steps
-    options.force_tolerance = spec_.solver.minimiser.force_tolerance;
-    options.max_iterations = static_cast<int>(spec_.solver.minimiser.max_iterations);
-    options.observer = observer_;
-    options.distributed = distributed_;
-    const mess::MinimiserResult r = mess::minimise(system_, options);
+    const mess::MinimiserResult r = mess::minimise(system_, minimiser_options());
     record.converged = r.converged;
     record.status = to_string(r.status);
     record.iterations = r.iterations;

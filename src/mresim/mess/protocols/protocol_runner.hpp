@@ -115,6 +115,8 @@ class ProtocolRunner {
  private:
   std::size_t slot_of_field(std::size_t field_index) const;
   const SlotState* start_state(const StepSpec& step, const ProtocolState& state) const;
+  // The run file's solver settings for one relaxation, with the run's caches.
+  mess::MinimiserOptions minimiser_options() const;
 
   mess_config::MessSpec spec_;
   std::vector<StepSpec> steps_;

@@ -167,7 +167,7 @@ void MultilevelCorrection::build_levels(Eigen::Index exact_limit) {
       for (std::size_t i = 0; i < finer.size(); ++i) {
         const int lower = std::min(static_cast<int>(i / 2), m - 2);
         const double p0 = axis.plane[static_cast<std::size_t>(lower)];
-        const double p1 = axis.plane[static_cast<std::size_t>(lower + 1)];
+        const double p1 = axis.plane[static_cast<std::size_t>(lower) + 1];
         axis.lower.push_back(lower);
         axis.upper.push_back((finer[i] - p0) / (p1 - p0));
       }
@@ -184,159 +184,198 @@ void MultilevelCorrection::build_levels(Eigen::Index exact_limit) {
   }
 }
 
-void MultilevelCorrection::assemble(const lattice::Lattice& lattice, double volume_force_factor,
-                                    double scale) {
+namespace {
+
+// Sums the rank-one terms c z z^T of the reference Hessian projected onto one level: the
+// diagonal always, the 3 x 3 blocks of each point's neighbours (<= kReach apart) when the
+// level is solved exactly.
+class LevelAssembler {
+ public:
+  LevelAssembler(const std::array<std::vector<int>, 3>& planes, const Dims& fine,
+                 const Dims& points, const std::vector<std::int32_t>& dof_of_coordinate, bool exact)
+      : fine_(fine), points_(points), dof_of_coordinate_(dof_of_coordinate) {
+    // Each lattice plane's bracket on this level: the composition of the levels' linear
+    // interpolations is the linear interpolation in lattice coordinates (nested grids).
+    for (std::size_t a = 0; a < 3; ++a) {
+      const std::vector<int>& plane = planes[a];
+      std::size_t j = 0;
+      for (int f = 0; f < fine_[a]; ++f) {
+        while (j + 2 < plane.size() && plane[j + 1] <= f) ++j;
+        lower_[a].push_back(static_cast<int>(j));
+        upper_[a].push_back(static_cast<double>(f - plane[j]) / (plane[j + 1] - plane[j]));
+      }
+    }
+    const std::int64_t count = point_count(points_);
+    diagonal_.assign(static_cast<std::size_t>(3 * count), 0.0);
+    if (exact) blocks_.assign(static_cast<std::size_t>(count * kNeighbours * 9), 0.0);
+  }
+
+  void clear() { z_.clear(); }
+
+  // z += sign direction_a phi_n for the free coordinates a of lattice node n.
+  void add_node(std::int64_t n, const Eigen::Vector3d& direction, double sign) {
+    const auto nz = static_cast<std::int64_t>(fine_[2]);
+    const auto nx = static_cast<std::int64_t>(fine_[0]);
+    const std::array<std::int64_t, 3> i{(n / nz) % nx, n / nz / nx, n % nz};
+    for (int c = 0; c < 8; ++c) {
+      std::array<std::int64_t, 3> j{};
+      double w = sign;
+      for (std::size_t a = 0; a < 3; ++a) {
+        const bool up = ((c >> a) & 1) != 0;
+        const auto f = static_cast<std::size_t>(i[a]);
+        j[a] = lower_[a][f] + (up ? 1 : 0);
+        w *= up ? upper_[a][f] : 1.0 - upper_[a][f];
+      }
+      if (w == 0.0) continue;
+      const std::int64_t node =
+          j[2] + points_[2] * (j[0] + static_cast<std::int64_t>(points_[0]) * j[1]);
+      std::array<double, 3> value{};
+      for (std::size_t a = 0; a < 3; ++a) {
+        if (dof_of_coordinate_[static_cast<std::size_t>(3 * n) + a] >= 0) {
+          value[a] = w * direction[static_cast<Eigen::Index>(a)];
+        }
+      }
+      add_entry(z_, node, value);
+    }
+  }
+
+  // Adds c z z^T.
+  void add_term(double c) {
+    for (const Entry& e : z_) {
+      for (std::size_t a = 0; a < 3; ++a) {
+        diagonal_[static_cast<std::size_t>(3 * e.node) + a] += c * e.value[a] * e.value[a];
+      }
+    }
+    if (blocks_.empty()) return;
+    for (const Entry& e : z_) {
+      const auto je = coordinates(e.node);
+      for (const Entry& f : z_) {
+        const auto jf = coordinates(f.node);
+        const std::int64_t code = (jf[0] - je[0] + kReach) * kWidth * kWidth +
+                                  (jf[1] - je[1] + kReach) * kWidth + (jf[2] - je[2] + kReach);
+        double* block = blocks_.data() + (e.node * kNeighbours + code) * 9;
+        for (std::size_t a = 0; a < 3; ++a) {
+          for (std::size_t b = 0; b < 3; ++b) block[3 * a + b] += c * e.value[a] * f.value[b];
+        }
+      }
+    }
+  }
+
+  std::array<std::int64_t, 3> coordinates(std::int64_t node) const {
+    return {(node / points_[2]) % points_[0], node / points_[2] / points_[0], node % points_[2]};
+  }
+  const std::vector<double>& diagonal() const { return diagonal_; }
+  const std::vector<double>& blocks() const { return blocks_; }
+
+ private:
+  Dims fine_;
+  Dims points_;
+  const std::vector<std::int32_t>& dof_of_coordinate_;
+  std::array<std::vector<int>, 3> lower_;
+  std::array<std::vector<double>, 3> upper_;
+  std::vector<Entry> z_;
+  std::vector<double> diagonal_;
+  std::vector<double> blocks_;
+};
+
+// The reference Hessian's rank-one terms: each spring at rest k e e^T on (x_j - x_i), e the rest
+// direction (eq. 4.62's Hessian); each cell f kappa g g^T / V0 with g_a = +-l_e^2 / 4 at each
+// vertex (as the diagonal of RigidParticlePreconditioner).
+void add_reference_hessian(const lattice::Lattice& lattice, double volume_force_factor,
+                           double scale, LevelAssembler& level) {
   const Eigen::Matrix3Xd& x0 = lattice.positions;
   const double l_e = lattice.element_length;
-  const auto nz = static_cast<std::int64_t>(fine_[2]);
-  const auto nx = static_cast<std::int64_t>(fine_[0]);
+  const lattice::SpringSet& sp = lattice.springs;
+  for (std::size_t s = 0; s < sp.size(); ++s) {
+    const std::int64_t i = sp.first[s];
+    const std::int64_t j = sp.second(s);
+    const Eigen::Vector3d e = (x0.col(j) - x0.col(i)).normalized();
+    level.clear();
+    level.add_node(j, e, 1.0);
+    level.add_node(i, e, -1.0);
+    level.add_term(sp.stiffness(s) * scale);
+  }
+  const double cell =
+      volume_force_factor * std::abs(lattice.polymer.kappa) / (l_e * l_e * l_e) * scale;
+  for (const auto& element : lattice.elements) {
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (const std::int32_t n : element) centre += x0.col(n);
+    centre /= 8.0;
+    level.clear();
+    for (const std::int32_t n : element) {
+      level.add_node(n, (x0.col(n) - centre).cwiseSign() * (l_e * l_e / 4.0), 1.0);
+    }
+    level.add_term(cell);
+  }
+}
+
+}  // namespace
+
+void MultilevelCorrection::assemble(const lattice::Lattice& lattice, double volume_force_factor,
+                                    double scale) {
   for (std::size_t li = 0; li < levels_.size(); ++li) {
     Level& level = levels_[li];
     const bool exact = li + 1 == levels_.size();
-    const Dims& p = level.points;
-    const std::int64_t points = point_count(p);
-    // Each lattice plane's bracket on this level: the composition of the levels' linear
-    // interpolations is the linear interpolation in lattice coordinates (nested grids).
-    std::array<std::vector<int>, 3> lower;
-    std::array<std::vector<double>, 3> upper;
-    for (std::size_t a = 0; a < 3; ++a) {
-      const std::vector<int>& plane = level.axes[a].plane;
-      int j = 0;
-      for (int f = 0; f < fine_[a]; ++f) {
-        while (j + 2 < static_cast<int>(plane.size()) &&
-               plane[static_cast<std::size_t>(j + 1)] <= f)
-          ++j;
-        lower[a].push_back(j);
-        upper[a].push_back(
-            static_cast<double>(f - plane[static_cast<std::size_t>(j)]) /
-            (plane[static_cast<std::size_t>(j + 1)] - plane[static_cast<std::size_t>(j)]));
-      }
-    }
-    std::vector<Entry> z;
-    // z += sign direction_a phi_n for the free coordinates a of lattice node n.
-    const auto add_node = [&](std::int64_t n, const Eigen::Vector3d& direction, double sign) {
-      const std::array<std::int64_t, 3> i{(n / nz) % nx, n / nz / nx, n % nz};
-      for (int c = 0; c < 8; ++c) {
-        std::array<std::int64_t, 3> j{};
-        double w = sign;
-        for (std::size_t a = 0; a < 3; ++a) {
-          const bool up = ((c >> a) & 1) != 0;
-          const auto f = static_cast<std::size_t>(i[a]);
-          j[a] = lower[a][f] + (up ? 1 : 0);
-          w *= up ? upper[a][f] : 1.0 - upper[a][f];
-        }
-        if (w == 0.0) continue;
-        const std::int64_t node = j[2] + p[2] * (j[0] + static_cast<std::int64_t>(p[0]) * j[1]);
-        std::array<double, 3> value{};
-        for (std::size_t a = 0; a < 3; ++a) {
-          if (dof_of_coordinate_[static_cast<std::size_t>(3 * n) + a] >= 0) {
-            value[a] = w * direction[static_cast<Eigen::Index>(a)];
-          }
-        }
-        add_entry(z, node, value);
-      }
-    };
-    std::vector<double> diagonal(static_cast<std::size_t>(3 * points), 0.0);
-    std::vector<double> blocks;
-    if (exact) blocks.assign(static_cast<std::size_t>(points * kNeighbours * 9), 0.0);
-    const auto add_term = [&](double c) {
-      for (const Entry& e : z) {
-        for (std::size_t a = 0; a < 3; ++a) {
-          diagonal[static_cast<std::size_t>(3 * e.node) + a] += c * e.value[a] * e.value[a];
-        }
-      }
-      if (!exact) return;
-      for (const Entry& e : z) {
-        const std::array<std::int64_t, 3> je{(e.node / p[2]) % p[0], e.node / p[2] / p[0],
-                                             e.node % p[2]};
-        for (const Entry& f : z) {
-          const std::array<std::int64_t, 3> jf{(f.node / p[2]) % p[0], f.node / p[2] / p[0],
-                                               f.node % p[2]};
-          const std::int64_t code = (jf[0] - je[0] + kReach) * kWidth * kWidth +
-                                    (jf[1] - je[1] + kReach) * kWidth + (jf[2] - je[2] + kReach);
-          double* block = blocks.data() + (e.node * kNeighbours + code) * 9;
-          for (std::size_t a = 0; a < 3; ++a) {
-            for (std::size_t b = 0; b < 3; ++b) block[3 * a + b] += c * e.value[a] * f.value[b];
-          }
-        }
-      }
-    };
-    // Springs at rest: k e e^T on (x_j - x_i), e the rest direction (eq. 4.62's Hessian).
-    const lattice::SpringSet& sp = lattice.springs;
-    for (std::size_t s = 0; s < sp.size(); ++s) {
-      const std::int64_t i = sp.first[s];
-      const std::int64_t j = sp.second(s);
-      const Eigen::Vector3d e = (x0.col(j) - x0.col(i)).normalized();
-      z.clear();
-      add_node(j, e, 1.0);
-      add_node(i, e, -1.0);
-      add_term(sp.stiffness(s) * scale);
-    }
-    // Volume term at rest: f kappa g g^T / V0, g_a = +-l_e^2 / 4 at each vertex (as the
-    // diagonal of RigidParticlePreconditioner).
-    const double cell =
-        volume_force_factor * std::abs(lattice.polymer.kappa) / (l_e * l_e * l_e) * scale;
-    for (const auto& element : lattice.elements) {
-      Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-      for (const std::int32_t n : element) centre += x0.col(n);
-      centre /= 8.0;
-      z.clear();
-      for (const std::int32_t n : element) {
-        add_node(n, (x0.col(n) - centre).cwiseSign() * (l_e * l_e / 4.0), 1.0);
-      }
-      add_term(cell);
-    }
-
+    const std::int64_t points = point_count(level.points);
+    LevelAssembler assembler({level.axes[0].plane, level.axes[1].plane, level.axes[2].plane}, fine_,
+                             level.points, dof_of_coordinate_, exact);
+    add_reference_hessian(lattice, volume_force_factor, scale, assembler);
     level.residual.resize(3 * points);
     level.update.resize(3 * points);
-    if (!exact) {
-      level.inverse_diagonal = Eigen::VectorXd::Zero(3 * points);
-      for (std::int64_t q = 0; q < 3 * points; ++q) {
-        const double d = diagonal[static_cast<std::size_t>(q)];
-        if (d > 0.0) level.inverse_diagonal[q] = 1.0 / d;
-      }
+    if (exact) {
+      factor_coarsest(level.points, assembler.diagonal(), assembler.blocks());
       continue;
     }
-    exact_index_.assign(static_cast<std::size_t>(3 * points), -1);
-    Eigen::Index rows = 0;
-    for (std::size_t q = 0; q < diagonal.size(); ++q) {
-      if (diagonal[q] > 0.0) exact_index_[q] = rows++;
+    level.inverse_diagonal = Eigen::VectorXd::Zero(3 * points);
+    for (std::int64_t q = 0; q < 3 * points; ++q) {
+      const double d = assembler.diagonal()[static_cast<std::size_t>(q)];
+      if (d > 0.0) level.inverse_diagonal[q] = 1.0 / d;
     }
-    std::vector<Eigen::Triplet<double>> triplets;
-    for (std::int64_t e = 0; e < points; ++e) {
-      const std::array<std::int64_t, 3> je{(e / p[2]) % p[0], e / p[2] / p[0], e % p[2]};
-      for (int code = 0; code < kNeighbours; ++code) {
-        const std::array<std::int64_t, 3> jf{je[0] + code / (kWidth * kWidth) - kReach,
-                                             je[1] + (code / kWidth) % kWidth - kReach,
-                                             je[2] + code % kWidth - kReach};
-        if (jf[0] < 0 || jf[1] < 0 || jf[2] < 0 || jf[0] >= p[0] || jf[1] >= p[1] ||
-            jf[2] >= p[2]) {
-          continue;
-        }
-        const std::int64_t f = jf[2] + p[2] * (jf[0] + static_cast<std::int64_t>(p[0]) * jf[1]);
-        for (int a = 0; a < 3; ++a) {
-          const Eigen::Index row = exact_index_[static_cast<std::size_t>(3 * e + a)];
-          if (row < 0) continue;
-          for (int b = 0; b < 3; ++b) {
-            const Eigen::Index col = exact_index_[static_cast<std::size_t>(3 * f + b)];
-            const double value =
-                blocks[static_cast<std::size_t>((e * kNeighbours + code) * 9 + 3 * a + b)];
-            if (col >= 0 && value != 0.0) triplets.emplace_back(row, col, value);
-          }
+  }
+}
+
+void MultilevelCorrection::factor_coarsest(const std::array<int, 3>& p,
+                                           const std::vector<double>& diagonal,
+                                           const std::vector<double>& blocks) {
+  const std::int64_t points = point_count(p);
+  exact_index_.assign(static_cast<std::size_t>(3 * points), -1);
+  Eigen::Index rows = 0;
+  for (std::size_t q = 0; q < diagonal.size(); ++q) {
+    if (diagonal[q] > 0.0) exact_index_[q] = rows++;
+  }
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (std::int64_t e = 0; e < points; ++e) {
+    const std::array<std::int64_t, 3> je{(e / p[2]) % p[0], e / p[2] / p[0], e % p[2]};
+    for (int code = 0; code < kNeighbours; ++code) {
+      const std::array<std::int64_t, 3> jf{je[0] + code / (kWidth * kWidth) - kReach,
+                                           je[1] + (code / kWidth) % kWidth - kReach,
+                                           je[2] + code % kWidth - kReach};
+      if (jf[0] < 0 || jf[1] < 0 || jf[2] < 0 || jf[0] >= p[0] || jf[1] >= p[1] || jf[2] >= p[2]) {
+        continue;
+      }
+      const std::int64_t f = jf[2] + p[2] * (jf[0] + static_cast<std::int64_t>(p[0]) * jf[1]);
+      for (std::int64_t a = 0; a < 3; ++a) {
+        const Eigen::Index row = exact_index_[static_cast<std::size_t>(3 * e + a)];
+        if (row < 0) continue;
+        for (std::int64_t b = 0; b < 3; ++b) {
+          const Eigen::Index col = exact_index_[static_cast<std::size_t>(3 * f + b)];
+          const double value =
+              blocks[static_cast<std::size_t>((e * kNeighbours + code) * 9 + 3 * a + b)];
+          if (col >= 0 && value != 0.0) triplets.emplace_back(row, col, value);
         }
       }
     }
-    Eigen::SparseMatrix<double> matrix(rows, rows);
-    matrix.setFromTriplets(triplets.begin(), triplets.end());
-    factor_.compute(matrix);
-    // Nothing held (or a rigid motion left free): A is singular and so is the coarsest matrix.
-    const Eigen::VectorXd pivots = factor_.vectorD();
-    if (factor_.info() != Eigen::Success || rows == 0 ||
-        !(pivots.minCoeff() > 1e-12 * pivots.maxCoeff())) {
-      throw std::runtime_error(
-          "MultilevelCorrection: the coarsest level's Hessian is singular (no rigid motion of "
-          "the lattice is held)");
-    }
+  }
+  Eigen::SparseMatrix<double> matrix(rows, rows);
+  matrix.setFromTriplets(triplets.begin(), triplets.end());
+  factor_.compute(matrix);
+  // Nothing held (or a rigid motion left free): A is singular and so is the coarsest matrix.
+  const Eigen::VectorXd pivots = factor_.vectorD();
+  if (factor_.info() != Eigen::Success || rows == 0 ||
+      !(pivots.minCoeff() > 1e-12 * pivots.maxCoeff())) {
+    throw std::runtime_error(
+        "MultilevelCorrection: the coarsest level's Hessian is singular (no rigid motion of the "
+        "lattice is held)");
   }
 }
 

@@ -84,6 +84,10 @@ class MultilevelCorrection {
 
   void build_levels(Eigen::Index exact_limit);
   void assemble(const lattice::Lattice& lattice, double volume_force_factor, double scale);
+  // The coarsest level's matrix from its diagonal and neighbour blocks (LevelAssembler), and
+  // its LDL^T; throws std::runtime_error if it is singular.
+  void factor_coarsest(const std::array<int, 3>& points, const std::vector<double>& diagonal,
+                       const std::vector<double>& blocks);
 
   std::array<int, 3> fine_{};
   // Flat coordinate 3 n + a -> its own dof, or -1 (held, or a rigid group's node): 12 bytes
