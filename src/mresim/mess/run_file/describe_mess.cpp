@@ -242,9 +242,10 @@ void describe_solver(const MessSpec& s, app::InfoReport& r) {
                v.method == SolverMethod::newton  ? "newton"
                : v.method == SolverMethod::lbfgs ? "lbfgs"
                                                  : "minimiser",
-               v.method == SolverMethod::newton  ? "Newton-Krylov with algebraic multigrid"
-               : v.method == SolverMethod::lbfgs ? "L-BFGS, rigid-particle preconditioner"
-                                                 : "L-BFGS, multilevel preconditioner");
+               v.method == SolverMethod::newton ? "Newton-Krylov with algebraic multigrid"
+               : v.method == SolverMethod::lbfgs
+                   ? "L-BFGS, rigid-particle preconditioner"
+                   : "L-BFGS, multilevel preconditioner from 40,000 nodes");
     r.add(sec, "force_tolerance", v.minimiser.force_tolerance, "k_eff l_e",
           "largest net force on a free node");
     r.add_integer(sec, "max_iterations", v.minimiser.max_iterations);
