@@ -269,7 +269,7 @@ TEST(MultilevelCorrection, MinimiserReachesTheSameStateWithIt) {
     options.lbfgs_preconditioner = preconditioner;
     const mess::MinimiserResult r = mess::minimise(sys, options);
     EXPECT_TRUE(r.converged) << mess::to_string(r.status);
-    return std::pair{sys.positions() / l.element_length, r.iterations};
+    return std::pair{Eigen::Matrix3Xd(sys.positions() / l.element_length), r.iterations};
   };
   const auto [with, with_iterations] = relax(mess::LbfgsPreconditioner::multilevel);
   const auto [without, without_iterations] = relax(mess::LbfgsPreconditioner::rigid_particles);
