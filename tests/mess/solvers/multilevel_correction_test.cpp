@@ -32,9 +32,10 @@ Eigen::VectorXd random_vector(Eigen::Index n, unsigned seed) {
   return v;
 }
 
-Eigen::VectorXd apply(const mess::MultilevelCorrection& c, const Eigen::VectorXd& v) {
+Eigen::VectorXd apply(const mess::MultilevelCorrection& c, const mess::DofMap& map,
+                      const Eigen::VectorXd& v) {
   Eigen::VectorXd w = Eigen::VectorXd::Zero(v.size());
-  c.add_to(v, w);
+  c.add_to(map, v, w);
   return w;
 }
 
@@ -156,7 +157,7 @@ TEST(MultilevelCorrection, IsTheGalerkinFormulaOnEveryLevel) {
     for (unsigned seed = 1; seed <= 3; ++seed) {
       const Eigen::VectorXd v = random_vector(map.size(), seed);
       const Eigen::VectorXd want = expected * v;
-      EXPECT_LT((apply(c, v) - want).norm(), 1e-11 * want.norm()) << profile_name;
+      EXPECT_LT((apply(c, map, v) - want).norm(), 1e-11 * want.norm()) << profile_name;
     }
   }
 }
@@ -173,10 +174,15 @@ TEST(MultilevelCorrection, IsSymmetricPositiveDefinite) {
                                      kForceScale);
   const Eigen::VectorXd v = random_vector(map.size(), 11);
   const Eigen::VectorXd w = random_vector(map.size(), 12);
-  const double vcw = v.dot(apply(c, w));
-  EXPECT_NEAR(vcw, w.dot(apply(c, v)), 1e-12 * std::abs(vcw));
-  EXPECT_GT(v.dot(apply(c, v)), 0.0);
-  EXPECT_GT(w.dot(apply(c, w)), 0.0);
+  const double vcw = v.dot(apply(c, map, w));
+  EXPECT_NEAR(vcw, w.dot(apply(c, map, v)), 1e-12 * std::abs(vcw));
+  EXPECT_GT(v.dot(apply(c, map, v)), 0.0);
+  EXPECT_GT(w.dot(apply(c, map, w)), 0.0);
+  // It reads the lattice through the map it is given: one with other free coordinates is refused.
+  sys.set_constraints(faces_held(l, {lat::Face::bottom}));
+  const mess::DofMap other(sys.constraints(), l.positions, l.element_length);
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(other.size());
+  EXPECT_THROW(c.add_to(other, random_vector(other.size(), 13), out), std::invalid_argument);
 }
 
 // The grid sweeps are split over threads by grid lines: bitwise the same result for 1, 2 and 3
@@ -196,13 +202,13 @@ TEST(MultilevelCorrection, IsBitwiseTheSameOnEveryThreadCount) {
                                      kForceScale);
   EXPECT_GE(c.levels(), 2);
   const Eigen::VectorXd v = random_vector(map.size(), 5);
-  const Eigen::VectorXd one = apply(c, v);
+  const Eigen::VectorXd one = apply(c, map, v);
   for (const int t : {2, 3}) {
     omp_set_num_threads(t);
     const mess::MultilevelCorrection other(l, sys.settings().elastic.volume_force_factor, map,
                                            kForceScale);
-    EXPECT_EQ(apply(other, v), one) << t << " threads";
-    EXPECT_EQ(apply(c, v), one) << t << " threads";
+    EXPECT_EQ(apply(other, map, v), one) << t << " threads";
+    EXPECT_EQ(apply(c, map, v), one) << t << " threads";
   }
   omp_set_num_threads(threads);
 }
@@ -220,7 +226,7 @@ TEST(MultilevelCorrection, IsLeftOutWhereNothingIsHeld) {
   EXPECT_EQ(p.multilevel(), nullptr);
   const Eigen::VectorXd v = random_vector(map.size(), 3);
   const mess::RigidParticlePreconditioner plain(sys, map, kForceScale, false);
-  EXPECT_EQ(p.apply(v), plain.apply(v));
+  EXPECT_EQ(p.apply(map, v), plain.apply(map, v));
 }
 
 // A run keeps one preconditioner while the free coordinates stay, and builds a new one when

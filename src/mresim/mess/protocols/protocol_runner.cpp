@@ -112,10 +112,20 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   LoadState load = protocol.load(lat, step, reference);
 
   const SlotState* start = start_state(step, state);
+  SlotState& slot = state.slots[slot_of_field(step.field_index)];
   system_.set_constraints(std::move(load.constraints));
   system_.set_applied_forces(load.applied_forces);
-  system_.set_positions(start != nullptr && start->positions.cols() > 0 ? start->positions
-                                                                        : lat.positions);
+  if (start == &slot && slot.positions.cols() > 0) {
+    // The step replaces the state it starts from (a field loop's one slot; a load step's own):
+    // the system takes the positions over instead of copying them, 24 bytes per node less
+    // while it relaxes. The slot is written again below; if the step throws, the run ends and
+    // resumes from its last checkpoint.
+    system_.set_positions(std::move(slot.positions));
+    slot.positions.resize(3, 0);
+  } else {
+    system_.set_positions(start != nullptr && start->positions.cols() > 0 ? start->positions
+                                                                          : lat.positions);
+  }
   if (start != nullptr && start->magnetization.cols() > 0) {
     system_.set_magnetizations(start->magnetization);
   }
@@ -174,7 +184,6 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   record.measured_strain = protocol.measured_strain(lat, step, system_.positions(), zero_load);
 
   // Advance the state.
-  SlotState& slot = state.slots[slot_of_field(step.field_index)];
   slot.positions = system_.positions();
   slot.magnetization = system_.magnetizations();
   if (step.load_index == 0 && !state.references.empty()) {

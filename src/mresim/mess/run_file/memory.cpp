@@ -11,7 +11,6 @@
 #include <string>
 
 #include "mresim/mess/run_file/mess_spec.hpp"
-#include "mresim/mess/solvers/minimiser.hpp"
 
 namespace mresim::mess_config {
 
@@ -59,12 +58,8 @@ std::string mib(std::int64_t bytes) {
 }  // namespace
 
 std::int64_t bytes_per_node(const MessSpec& spec) {
-  if (spec.solver.method == SolverMethod::newton) return kNewtonBytesPerNode;
-  if (spec.solver.method == SolverMethod::minimiser &&
-      spec.geometry.node_count() >= mess::kMultilevelMinimumNodes) {
-    return kMultilevelBytesPerNode;  // LbfgsPreconditioner::automatic's choice
-  }
-  return kBytesPerNode;
+  // L-BFGS with or without the multilevel preconditioner: one figure (kBytesPerNode).
+  return spec.solver.method == SolverMethod::newton ? kNewtonBytesPerNode : kBytesPerNode;
 }
 
 std::int64_t estimated_memory_bytes(const MessSpec& spec) {

@@ -285,14 +285,11 @@ MessSpec read_mess_run_file(const config::TableReader& root);
 
 // Measured peak resident memory of a 3D run with the minimiser, per lattice node (nodes,
 // springs, cells, forces, the minimiser's history, the seed's correction passes and the
-// checkpoint copy together): the full-size Fig. 4.11 pair (284,592 nodes, two steps with a
-// correction pass) peaks at 991 bytes per node, the process's own memory included, rounded up.
+// checkpoint copy together), the process's own memory included, rounded up: the full-size
+// Fig. 4.11 pair (284,592 nodes) peaks at 987 bytes per node over its first three steps with the
+// default multilevel preconditioner (solver.method = "minimiser" from
+// mess::kMultilevelMinimumNodes nodes on) and below that with "lbfgs" (docs/performance.md).
 inline constexpr std::int64_t kBytesPerNode = 1000;
-// The same with the multilevel preconditioner (solver.method = "minimiser" on lattices of at
-// least mess::kMultilevelMinimumNodes nodes): its coordinate map, levels, coarsest factor and
-// transient sweeps come on top; the full-size Fig. 4.11 pair peaks at 1,040 bytes per node over
-// its first three steps (958 with "lbfgs" in the same binary), rounded up with the margin above.
-inline constexpr std::int64_t kMultilevelBytesPerNode = 1100;
 // The same with solver.method = "newton": the elastic Hessian's sparse matrix (81 entries per
 // row, 2.9 kB per node) and the multigrid built on it come on top; measured peak RSS 311 MiB at
 // 48,600 nodes and 1,696 MiB at 284,592 nodes (the full-size Fig. 4.11 pair), a slope of

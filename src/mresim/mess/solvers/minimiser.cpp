@@ -310,9 +310,6 @@ class Minimisation {
         measure_(system, map),
         f_(system, map, force_scale, options.distributed.get()),
         u_(map.to_dofs(system.positions())),
-        // Nodal masses in units of m_c (FIRE only).
-        mass_(map.reduce_masses(system.lattice().masses) /
-              detail::characteristic_mass(system.lattice())),
         alternating_(alternating),
         budget_(options.max_iterations),
         method_(options.method) {
@@ -437,11 +434,15 @@ class Minimisation {
       return newton_solver().run(f_, u_, budget_, opt_, use_energy_, test);
     }
     if (method_ == MinimiserMethod::fire) {
-      return run_fire(f_, rules_, u_, budget_, opt_, mass_, test);
+      // Nodal masses in units of m_c, formed only when FIRE runs: kept through every L-BFGS
+      // run they would cost 24 bytes per node at its peak.
+      const Eigen::VectorXd mass = map_.reduce_masses(system_.lattice().masses) /
+                                   detail::characteristic_mass(system_.lattice());
+      return run_fire(f_, rules_, u_, budget_, opt_, mass, test);
     }
     LbfgsMemory::Preconditioner P;
     if (preconditioner_ != nullptr) {
-      P = [this](const Eigen::VectorXd& v) { return preconditioner_->apply(v); };
+      P = [this](const Eigen::VectorXd& v) { return preconditioner_->apply(map_, v); };
     } else if (opt_.precondition) {
       // Newton's multigrid; its contact correction at the state this inner run starts from.
       detail::NewtonSolver& newton = newton_solver();
@@ -596,7 +597,6 @@ class Minimisation {
   const ForceMeasure measure_;
   Objective f_;
   Eigen::VectorXd u_;
-  const Eigen::VectorXd mass_;
   std::shared_ptr<const RigidParticlePreconditioner> preconditioner_;
   std::unique_ptr<detail::NewtonSolver> newton_;
   MinimiserResult res_;

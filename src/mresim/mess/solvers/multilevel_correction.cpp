@@ -130,17 +130,9 @@ MultilevelCorrection::MultilevelCorrection(const lattice::Lattice& lattice,
                                 " must be at least 1");
   }
   fine_ = lattice.shape.nodes;
-  const std::int64_t nodes = lattice.node_count();
-  if (map.own_dofs() > std::numeric_limits<std::int32_t>::max()) {
-    throw std::invalid_argument("MultilevelCorrection: more than 2^31 free coordinates");
-  }
-  dof_of_coordinate_.assign(static_cast<std::size_t>(3 * nodes), -1);
-  for (Eigen::Index k = 0; k < map.own_dofs(); ++k) {
-    dof_of_coordinate_[static_cast<std::size_t>(map.coordinate_of(k))] =
-        static_cast<std::int32_t>(k);
-  }
+  own_dofs_ = map.own_dofs();
   build_levels(exact_limit);
-  assemble(lattice, volume_force_factor, lattice.element_length / force_scale);
+  assemble(lattice, volume_force_factor, lattice.element_length / force_scale, map);
 }
 
 Eigen::Index MultilevelCorrection::level_size(int level) const {
@@ -192,8 +184,8 @@ namespace {
 class LevelAssembler {
  public:
   LevelAssembler(const std::array<std::vector<int>, 3>& planes, const Dims& fine,
-                 const Dims& points, const std::vector<std::int32_t>& dof_of_coordinate, bool exact)
-      : fine_(fine), points_(points), dof_of_coordinate_(dof_of_coordinate) {
+                 const Dims& points, const DofMap& map, bool exact)
+      : fine_(fine), points_(points), map_(map) {
     // Each lattice plane's bracket on this level: the composition of the levels' linear
     // interpolations is the linear interpolation in lattice coordinates (nested grids).
     for (std::size_t a = 0; a < 3; ++a) {
@@ -231,7 +223,7 @@ class LevelAssembler {
           j[2] + points_[2] * (j[0] + static_cast<std::int64_t>(points_[0]) * j[1]);
       std::array<double, 3> value{};
       for (std::size_t a = 0; a < 3; ++a) {
-        if (dof_of_coordinate_[static_cast<std::size_t>(3 * n) + a] >= 0) {
+        if (map_.own_dof_of_coordinate(3 * n + static_cast<std::int64_t>(a)) >= 0) {
           value[a] = w * direction[static_cast<Eigen::Index>(a)];
         }
       }
@@ -270,7 +262,7 @@ class LevelAssembler {
  private:
   Dims fine_;
   Dims points_;
-  const std::vector<std::int32_t>& dof_of_coordinate_;
+  const DofMap& map_;
   std::array<std::vector<int>, 3> lower_;
   std::array<std::vector<double>, 3> upper_;
   std::vector<Entry> z_;
@@ -312,16 +304,14 @@ void add_reference_hessian(const lattice::Lattice& lattice, double volume_force_
 }  // namespace
 
 void MultilevelCorrection::assemble(const lattice::Lattice& lattice, double volume_force_factor,
-                                    double scale) {
+                                    double scale, const DofMap& map) {
   for (std::size_t li = 0; li < levels_.size(); ++li) {
     Level& level = levels_[li];
     const bool exact = li + 1 == levels_.size();
     const std::int64_t points = point_count(level.points);
     LevelAssembler assembler({level.axes[0].plane, level.axes[1].plane, level.axes[2].plane}, fine_,
-                             level.points, dof_of_coordinate_, exact);
+                             level.points, map, exact);
     add_reference_hessian(lattice, volume_force_factor, scale, assembler);
-    level.residual.resize(3 * points);
-    level.update.resize(3 * points);
     if (exact) {
       factor_coarsest(level.points, assembler.diagonal(), assembler.blocks());
       continue;
@@ -379,13 +369,21 @@ void MultilevelCorrection::factor_coarsest(const std::array<int, 3>& p,
   }
 }
 
-void MultilevelCorrection::add_to(const Eigen::VectorXd& v, Eigen::VectorXd& w) const {
+void MultilevelCorrection::add_to(const DofMap& map, const Eigen::VectorXd& v,
+                                  Eigen::VectorXd& w) const {
+  if (map.own_dofs() != own_dofs_) {
+    throw std::invalid_argument("MultilevelCorrection::add_to: the map has " +
+                                std::to_string(map.own_dofs()) +
+                                " free coordinates, the correction " + std::to_string(own_dofs_));
+  }
   // The lattice field is v read through the coordinates' dofs (0 on held coordinates and rigid
-  // groups' nodes); the coarse fields are vectors.
+  // groups' nodes); the coarse fields are vectors, held only while C is applied.
   const auto read_lattice = [&](std::int64_t coordinate) {
-    const std::int32_t k = dof_of_coordinate_[static_cast<std::size_t>(coordinate)];
+    const Eigen::Index k = map.own_dof_of_coordinate(coordinate);
     return k >= 0 ? v[k] : 0.0;
   };
+  std::vector<Eigen::VectorXd> residual(levels_.size());  // Phi_l^T v
+  std::vector<Eigen::VectorXd> update(levels_.size());    // what level l hands to the finer one
   Dims dims = fine_;
   for (std::size_t li = 0; li < levels_.size(); ++li) {
     const Level& level = levels_[li];
@@ -393,25 +391,26 @@ void MultilevelCorrection::add_to(const Eigen::VectorXd& v, Eigen::VectorXd& w) 
     if (li == 0) {
       restrict_axis(read_lattice, dims, 2, level, along_z);
     } else {
-      restrict_axis(vector_reader(levels_[li - 1].residual), dims, 2, level, along_z);
+      restrict_axis(vector_reader(residual[li - 1]), dims, 2, level, along_z);
     }
     dims[2] = level.points[2];
     Eigen::VectorXd along_x;
     restrict_axis(vector_reader(along_z), dims, 0, level, along_x);
     dims[0] = level.points[0];
-    restrict_axis(vector_reader(along_x), dims, 1, level, level.residual);
+    restrict_axis(vector_reader(along_x), dims, 1, level, residual[li]);
     dims[1] = level.points[1];
   }
 
-  const Level& coarsest = levels_.back();
+  const std::size_t last = levels_.size() - 1;
   Eigen::VectorXd compact(factor_.rows());
   for (std::size_t q = 0; q < exact_index_.size(); ++q) {
     if (exact_index_[q] >= 0)
-      compact[exact_index_[q]] = coarsest.residual[static_cast<Eigen::Index>(q)];
+      compact[exact_index_[q]] = residual[last][static_cast<Eigen::Index>(q)];
   }
   const Eigen::VectorXd solved = factor_.solve(compact);
+  update[last].resize(residual[last].size());
   for (std::size_t q = 0; q < exact_index_.size(); ++q) {
-    coarsest.update[static_cast<Eigen::Index>(q)] =
+    update[last][static_cast<Eigen::Index>(q)] =
         exact_index_[q] >= 0 ? solved[exact_index_[q]] : 0.0;
   }
   // Interpolation back, level by level (y, x, z); each finer level adds its own scaled part,
@@ -422,18 +421,19 @@ void MultilevelCorrection::add_to(const Eigen::VectorXd& v, Eigen::VectorXd& w) 
     Dims d = level.points;
     Eigen::VectorXd along_y;
     d[1] = finer[1];
-    interpolate_axis(level.update, level.points, 1, level, d, vector_writer(along_y, d));
+    interpolate_axis(update[li], level.points, 1, level, d, vector_writer(along_y, d));
+    update[li] = Eigen::VectorXd();  // done with: its memory goes before the finer level's
     Eigen::VectorXd along_x;
     Dims dx = d;
     dx[0] = finer[0];
     interpolate_axis(along_y, d, 0, level, dx, vector_writer(along_x, dx));
     if (li > 0) {
-      const Level& next = levels_[li - 1];
-      interpolate_axis(along_x, dx, 2, level, finer, vector_writer(next.update, finer));
-      next.update += next.inverse_diagonal.cwiseProduct(next.residual);
+      Eigen::VectorXd& next = update[li - 1];
+      interpolate_axis(along_x, dx, 2, level, finer, vector_writer(next, finer));
+      next += levels_[li - 1].inverse_diagonal.cwiseProduct(residual[li - 1]);
     } else {
       interpolate_axis(along_x, dx, 2, level, finer, [&](std::int64_t coordinate, double value) {
-        const std::int32_t k = dof_of_coordinate_[static_cast<std::size_t>(coordinate)];
+        const Eigen::Index k = map.own_dof_of_coordinate(coordinate);
         if (k >= 0) w[k] += value;
       });
     }

@@ -26,8 +26,10 @@
 // first reads v in place), scales, solves the coarsest level and interpolates back (the last
 // sweep adds into w): about a fifth of an energy evaluation at 285k nodes. The sweeps are split
 // over the threads by grid lines, so the result is bitwise the same for any number of threads.
-// Memory: a coordinate-to-dof map (12 bytes per node), the levels (about 10 bytes per node) and
-// the sweeps' transient arrays (18 bytes per node while C is applied). Building it sweeps the
+// Memory: the levels' inverse diagonals (about 3 bytes per node) and the coarsest level's
+// factor (about 23 bytes per node at 285k nodes); while C is applied, the sweeps' transient
+// arrays (18 bytes per node) and the levels' fields. The free coordinates are read through the
+// minimiser's DofMap, which add_to() is given, instead of a copy of its map. Building it sweeps the
 // lattice's springs and cells once per level (each term's Hessian has rank one at rest: k e e^T per
 // spring, f kappa g g^T / V0 per cell); the result depends only on the lattice, the free
 // coordinates and the force scale, so a run keeps it for all its steps (PreconditionerCache,
@@ -57,8 +59,10 @@ class MultilevelCorrection {
                        const DofMap& map, double force_scale,
                        Eigen::Index exact_limit = kDefaultExactLimit);
 
-  // w += C v (v, w over the map's dofs).
-  void add_to(const Eigen::VectorXd& v, Eigen::VectorXd& w) const;
+  // w += C v (v, w over the map's dofs). `map`: one with the same free coordinates as the
+  // constructor's (PreconditionerCache keys on them); std::invalid_argument if its number of
+  // own dofs differs.
+  void add_to(const DofMap& map, const Eigen::VectorXd& v, Eigen::VectorXd& w) const;
 
   int levels() const { return static_cast<int>(levels_.size()); }
   // Coarse coordinates of level l (1-based, as in the header): 3 x its grid points.
@@ -78,21 +82,18 @@ class MultilevelCorrection {
     std::array<int, 3> points{};
     // 3 x points: diag(Phi^T A Phi)^-1 (0 where no free coordinate reaches), coarsest: unused.
     Eigen::VectorXd inverse_diagonal;
-    mutable Eigen::VectorXd residual;  // Phi_l^T v
-    mutable Eigen::VectorXd update;    // what level l hands to the finer level
   };
 
   void build_levels(Eigen::Index exact_limit);
-  void assemble(const lattice::Lattice& lattice, double volume_force_factor, double scale);
+  void assemble(const lattice::Lattice& lattice, double volume_force_factor, double scale,
+                const DofMap& map);
   // The coarsest level's matrix from its diagonal and neighbour blocks (LevelAssembler), and
   // its LDL^T; throws std::runtime_error if it is singular.
   void factor_coarsest(const std::array<int, 3>& points, const std::vector<double>& diagonal,
                        const std::vector<double>& blocks);
 
   std::array<int, 3> fine_{};
-  // Flat coordinate 3 n + a -> its own dof, or -1 (held, or a rigid group's node): 12 bytes
-  // per node, the correction's only array over the lattice besides its transient sweeps.
-  std::vector<std::int32_t> dof_of_coordinate_;
+  Eigen::Index own_dofs_ = 0;  // the constructor's map's (checked in add_to)
   std::vector<Level> levels_;
   std::vector<Eigen::Index> exact_index_;  // coarsest level: 3 J + a -> row of the factor, or -1
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factor_;

@@ -95,7 +95,8 @@ RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& syste
   }
 }
 
-Eigen::VectorXd RigidParticlePreconditioner::apply(const Eigen::VectorXd& v) const {
+Eigen::VectorXd RigidParticlePreconditioner::apply(const DofMap& map,
+                                                   const Eigen::VectorXd& v) const {
   Eigen::VectorXd w;
   detail::parallel_product(inverse_diagonal_, v, w);  // both cores: a million dofs at full size
   for (const Block& b : blocks_) {
@@ -110,7 +111,7 @@ Eigen::VectorXd RigidParticlePreconditioner::apply(const Eigen::VectorXd& v) con
     const Eigen::VectorXd wp = internal + b.q * (t / rigid_stiffness_);
     for (Eigen::Index i = 0; i < m; ++i) w[b.dofs[static_cast<std::size_t>(i)]] = wp[i];
   }
-  if (multilevel_ != nullptr) multilevel_->add_to(v, w);
+  if (multilevel_ != nullptr) multilevel_->add_to(map, v, w);
   return w;
 }
 

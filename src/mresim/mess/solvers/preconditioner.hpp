@@ -45,8 +45,9 @@ class RigidParticlePreconditioner {
   RigidParticlePreconditioner(const MessSystem& system, const DofMap& map, double force_scale,
                               bool multilevel = false);
 
-  // P v.
-  Eigen::VectorXd apply(const Eigen::VectorXd& v) const;
+  // P v. `map`: one with the same free coordinates and groups as the constructor's (as
+  // PreconditionerCache hands out); the multilevel correction reads the lattice through it.
+  Eigen::VectorXd apply(const DofMap& map, const Eigen::VectorXd& v) const;
 
   // The multilevel correction, or null (not asked for, or nothing held).
   const MultilevelCorrection* multilevel() const { return multilevel_.get(); }

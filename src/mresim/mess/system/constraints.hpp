@@ -112,6 +112,11 @@ class DofMap {
     return dof_index_[static_cast<std::size_t>(3 * node + axis)];
   }
   // Whether dof k is a rigid group's translation component.
+  // The own dof of flat coordinate c = 3 n + a, or -1 (held, or a node of a rigid group).
+  Eigen::Index own_dof_of_coordinate(std::int64_t c) const {
+    const std::int32_t k = dof_index_[static_cast<std::size_t>(c)];
+    return k < static_cast<std::int32_t>(coordinates_.size()) ? k : -1;
+  }
   bool is_group_dof(Eigen::Index k) const {
     return k >= static_cast<Eigen::Index>(coordinates_.size());
   }

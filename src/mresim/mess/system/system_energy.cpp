@@ -89,11 +89,15 @@ void MessSystem::set_applied_field(const Eigen::Vector3d& applied_field) {
 }
 
 void MessSystem::set_positions(const Eigen::Matrix3Xd& positions) {
+  set_positions(Eigen::Matrix3Xd(positions));
+}
+
+void MessSystem::set_positions(Eigen::Matrix3Xd&& positions) {
   if (positions.cols() != lattice_.node_count()) {
     throw std::invalid_argument("MessSystem::set_positions: expected " +
                                 std::to_string(lattice_.node_count()) + " columns");
   }
-  positions_ = positions;
+  positions_ = std::move(positions);
   constraints_.apply(positions_);
 }
 

@@ -123,6 +123,8 @@ class MessSystem {
   const Eigen::Matrix3Xd& positions() const { return positions_; }
   // All node positions (m); the held coordinates are then written from the constraints.
   void set_positions(const Eigen::Matrix3Xd& positions);
+  // The same, taking the array over instead of copying it.
+  void set_positions(Eigen::Matrix3Xd&& positions);
   // Mutable access for solvers; call apply_constraints() if held coordinates may have changed.
   Eigen::Matrix3Xd& mutable_positions() { return positions_; }
 
