@@ -239,6 +239,18 @@ TEST(MessMemory, EstimateIsFixedPlusPerNodePlusDenseMagnetization) {
   large.solver.method = mc::SolverMethod::lbfgs;
   EXPECT_EQ(mc::estimated_memory_bytes(large),
             mc::kFixedBytes + 40000 * mc::kBytesPerNode + 32 * 36);
+  // A strain run keeps the latest state and the zero-load reference of every field (48 bytes
+  // per node per field) for its whole length.
+  const std::string strain =
+      edit(edit(kAnisotropic, "type = \"mess_hysteresis\"", "type = \"mess_strain\""),
+           "[field]\nmax = 0.05\nsteps = 1\n",
+           "[field]\nmagnitudes = [0.0, 0.01, 0.02]\n[strain]\nkind = \"shear\"\nnormal = "
+           "\"z\"\ndirection = \"x\"\nmax = 0.02\nsteps = 2\n");
+  const mc::MessSpec sheared = spec_of(strain);
+  ASSERT_EQ(sheared.load_step_count(), 3U);
+  EXPECT_EQ(
+      mc::estimated_memory_bytes(sheared),
+      mc::kFixedBytes + 3700 * (mc::kBytesPerNode + 3 * mc::kPerFieldStateBytesPerNode) + 32 * 36);
   EXPECT_NO_THROW(mc::check_memory(spec, {std::nullopt, "unknown"}));
   try {
     mc::check_memory(spec, {1'000'000, "test"});
