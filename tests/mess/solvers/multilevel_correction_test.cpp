@@ -8,7 +8,9 @@
 
 #include <Eigen/Dense>
 #include <array>
+#include <cmath>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "../support/mess_test_support.hpp"
@@ -68,12 +70,11 @@ double hat(const std::vector<int>& p, std::size_t j, int i) {
 }
 
 // The header's formula, from dense matrices: sum over levels of Phi B Phi^T, B the inverse
-// diagonal of Phi^T A Phi on every level but the coarsest, its inverse on the coarsest.
-Eigen::MatrixXd reference_correction(const mess::MessSystem& sys, const mess::DofMap& map,
-                                     int levels) {
-  const lat::Lattice& l = sys.lattice();
+// diagonal of Phi^T A Phi on every level but the coarsest, its inverse on the coarsest; A the
+// free coordinates' block of `full` (3 N x 3 N, J/m^2).
+Eigen::MatrixXd reference_correction(const lat::Lattice& l, const Eigen::MatrixXd& full,
+                                     const mess::DofMap& map, int levels) {
   const Eigen::Index dofs = map.own_dofs();
-  const Eigen::MatrixXd full = Eigen::MatrixXd(sys.elastic_hessian());
   Eigen::MatrixXd a(dofs, dofs);
   for (Eigen::Index i = 0; i < dofs; ++i) {
     for (Eigen::Index j = 0; j < dofs; ++j)
@@ -127,6 +128,52 @@ Eigen::MatrixXd reference_correction(const mess::MessSystem& sys, const mess::Do
   return c;
 }
 
+// At rest the stiffness terms are the elastic Hessian itself.
+Eigen::MatrixXd reference_correction(const mess::MessSystem& sys, const mess::DofMap& map,
+                                     int levels) {
+  return reference_correction(sys.lattice(), Eigen::MatrixXd(sys.elastic_hessian()), map, levels);
+}
+
+// The stiffness terms of stiffness_terms.hpp at positions x as a dense 3 N x 3 N matrix, from
+// their definition: per spring k L/l u u^T, per cell force_factor kappa/V0 g g^T with g the
+// cell's volume gradient at x; a spring or cell with a node that has a held coordinate at rest.
+Eigen::MatrixXd stiffness_matrix(const lat::Lattice& l, const Eigen::Matrix3Xd& x,
+                                 const mess::DofMap& map, double force_factor) {
+  const auto n = static_cast<Eigen::Index>(3 * l.node_count());
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(n, n);
+  const auto held = [&](std::int64_t node) {
+    return map.dof_of(node, 0) < 0 || map.dof_of(node, 1) < 0 || map.dof_of(node, 2) < 0;
+  };
+  // Adds c z z^T, z given per node.
+  const auto add = [&](const std::vector<std::pair<std::int64_t, Eigen::Vector3d>>& z, double c) {
+    for (const auto& [i, zi] : z) {
+      for (const auto& [j, zj] : z) h.block<3, 3>(3 * i, 3 * j) += c * zi * zj.transpose();
+    }
+  };
+  for (std::size_t s = 0; s < l.springs.size(); ++s) {
+    const std::int64_t i = l.springs.first[s];
+    const std::int64_t j = l.springs.second(s);
+    const bool rest = held(i) || held(j);
+    const Eigen::Vector3d r = rest ? Eigen::Vector3d(l.positions.col(j) - l.positions.col(i))
+                                   : Eigen::Vector3d(x.col(j) - x.col(i));
+    const double c = l.springs.stiffness(s) * (rest ? 1.0 : l.springs.rest_length(s) / r.norm());
+    add({{j, r.normalized()}, {i, -r.normalized()}}, c);
+  }
+  const double v0 = std::pow(l.element_length, 3);
+  for (const auto& e : l.elements) {
+    bool rest = false;
+    for (const std::int32_t node : e) rest = rest || held(node);
+    lat::CellVertices v;
+    lat::CellVertices g;
+    for (std::size_t k = 0; k < 8; ++k) v[k] = (rest ? l.positions : x).col(e[k]);
+    (void)lat::cell_volume_and_gradient(v, g);
+    std::vector<std::pair<std::int64_t, Eigen::Vector3d>> z;
+    for (std::size_t k = 0; k < 8; ++k) z.emplace_back(e[k], g[k]);
+    add(z, force_factor * std::abs(l.polymer.kappa) / v0);
+  }
+  return h;
+}
+
 mess::BoundaryConstraints faces_held(const lat::Lattice& l,
                                      std::initializer_list<lat::Face> faces) {
   mess::BoundaryConstraints c = mess::BoundaryConstraints::none(l.node_count());
@@ -159,6 +206,45 @@ TEST(MultilevelCorrection, IsTheGalerkinFormulaOnEveryLevel) {
       const Eigen::VectorXd want = expected * v;
       EXPECT_LT((apply(c, map, v) - want).norm(), 1e-11 * want.norm()) << profile_name;
     }
+  }
+}
+
+// Built at a deformed state it is the formula with the stiffness terms at that state
+// (stiffness_terms.hpp): every node displaced at random by up to 0.2 l_e, a face held 0.5 l_e
+// away; the springs and cells of the held nodes stay at rest wherever x puts those nodes. Also:
+// built at the reference positions it is the one built at rest, to rounding.
+TEST(MultilevelCorrection, IsTheGalerkinFormulaAtADeformedState) {
+  const mess::ModelProfile& profile = mess::model_profile("seed");
+  mess::MessSystem sys = mess::MessSystem::make(small_lattice(profile, {8, 8, 8}, {{4, 4, 4}}),
+                                                Eigen::Vector3d::Zero(), profile);
+  const lat::Lattice& l = sys.lattice();
+  Eigen::Matrix3Xd x = l.positions;
+  std::mt19937 gen(7);
+  std::uniform_real_distribution<double> u(-0.2, 0.2);
+  for (Eigen::Index n = 0; n < x.cols(); ++n) {
+    for (int a = 0; a < 3; ++a) x(a, n) += u(gen) * l.element_length;
+  }
+  Eigen::Matrix3Xd top = x;
+  top.row(0).array() += 0.5 * l.element_length;
+  mess::BoundaryConstraints held = faces_held(l, {lat::Face::bottom});
+  held.fix_face(l.shape, lat::Face::top, top);
+  sys.set_constraints(held);
+  const mess::DofMap map(sys.constraints(), l.positions, l.element_length);
+  const double factor = sys.settings().elastic.volume_force_factor;
+  const mess::MultilevelCorrection c(l, factor, map, kForceScale, &x);
+  ASSERT_EQ(c.levels(), 3);
+  const Eigen::MatrixXd expected =
+      reference_correction(l, stiffness_matrix(l, x, map, factor), map, 3);
+  const mess::MultilevelCorrection at_rest(l, factor, map, kForceScale);
+  const mess::MultilevelCorrection at_reference(l, factor, map, kForceScale, &l.positions);
+  for (unsigned seed = 1; seed <= 3; ++seed) {
+    const Eigen::VectorXd v = random_vector(map.size(), seed);
+    const Eigen::VectorXd want = expected * v;
+    EXPECT_LT((apply(c, map, v) - want).norm(), 1e-11 * want.norm());
+    // The deformation changes it (else the check above could not tell the states apart).
+    const Eigen::VectorXd rest = apply(at_rest, map, v);
+    EXPECT_GT((rest - want).norm(), 1e-3 * want.norm());
+    EXPECT_LT((apply(at_reference, map, v) - rest).norm(), 1e-12 * rest.norm());
   }
 }
 
@@ -229,9 +315,10 @@ TEST(MultilevelCorrection, IsLeftOutWhereNothingIsHeld) {
   EXPECT_EQ(p.apply(map, v), plain.apply(map, v));
 }
 
-// A run keeps one preconditioner while the free coordinates stay, and builds a new one when
-// they change (another face held) or the multilevel choice does.
-TEST(PreconditionerCache, KeepsOnePreconditionerWhileTheFreeCoordinatesStay) {
+// A run keeps one plain preconditioner (built at rest) while the free coordinates stay, and
+// builds a new one when they change (another face held) or the multilevel choice does; one with
+// the multilevel correction is built anew at every request, at the system's positions.
+TEST(PreconditionerCache, KeepsThePlainOneAndBuildsTheMultilevelOneAtEachState) {
   const mess::ModelProfile& profile = mess::model_profile("physical");
   mess::MessSystem sys =
       mess::MessSystem::make(small_lattice(profile, {6, 6, 6}), Eigen::Vector3d::Zero(), profile);
@@ -239,8 +326,8 @@ TEST(PreconditionerCache, KeepsOnePreconditionerWhileTheFreeCoordinatesStay) {
   sys.set_constraints(faces_held(l, {lat::Face::bottom}));
   mess::PreconditionerCache cache;
   const mess::DofMap map(sys.constraints(), l.positions, l.element_length);
-  const auto first = cache.get(sys, map, kForceScale, true);
-  ASSERT_NE(first->multilevel(), nullptr);
+  const auto first = cache.get(sys, map, kForceScale, false);
+  ASSERT_EQ(first->multilevel(), nullptr);
   // Other prescribed values of the same held coordinates: the same free coordinates.
   Eigen::Matrix3Xd moved = l.positions;
   moved.row(0).array() += 0.1 * l.element_length;
@@ -248,14 +335,29 @@ TEST(PreconditionerCache, KeepsOnePreconditionerWhileTheFreeCoordinatesStay) {
   shifted.fix_face(l.shape, lat::Face::bottom, moved);
   sys.set_constraints(shifted);
   const mess::DofMap same(sys.constraints(), l.positions, l.element_length);
-  EXPECT_EQ(cache.get(sys, same, kForceScale, true), first);
+  EXPECT_EQ(cache.get(sys, same, kForceScale, false), first);
   EXPECT_EQ(cache.builds(), 1);
   sys.set_constraints(faces_held(l, {lat::Face::bottom, lat::Face::top}));
   const mess::DofMap other(sys.constraints(), l.positions, l.element_length);
-  EXPECT_NE(cache.get(sys, other, kForceScale, true), first);
+  const auto second = cache.get(sys, other, kForceScale, false);
+  EXPECT_NE(second, first);
   EXPECT_EQ(cache.builds(), 2);
-  EXPECT_EQ(cache.get(sys, other, kForceScale, false)->multilevel(), nullptr);
+
+  // Multilevel: a new one per request, built at the current positions.
+  const auto at_rest = cache.get(sys, other, kForceScale, true);
+  ASSERT_NE(at_rest->multilevel(), nullptr);
   EXPECT_EQ(cache.builds(), 3);
+  Eigen::Matrix3Xd x = sys.positions();
+  for (Eigen::Index n = 0; n < x.cols(); ++n) {
+    if (other.dof_of(n, 0) >= 0) x(0, n) += 0.1 * l.element_length * std::sin(0.7 * n);
+  }
+  sys.set_positions(x);
+  const auto deformed = cache.get(sys, other, kForceScale, true);
+  EXPECT_EQ(cache.builds(), 4);
+  const mess::RigidParticlePreconditioner direct(sys, other, kForceScale, true, &x);
+  const Eigen::VectorXd v = random_vector(other.size(), 4);
+  EXPECT_EQ(deformed->apply(other, v), direct.apply(other, v));
+  EXPECT_NE(deformed->apply(other, v), at_rest->apply(other, v));
 }
 
 // L-BFGS with the multilevel preconditioner reaches the state L-BFGS reaches without it: a

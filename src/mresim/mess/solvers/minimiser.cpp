@@ -321,8 +321,9 @@ class Minimisation {
       preconditioner_ =
           options.preconditioner_cache != nullptr
               ? options.preconditioner_cache->get(system, map, force_scale, multilevel)
-              : std::make_shared<const RigidParticlePreconditioner>(system, map, force_scale,
-                                                                    multilevel);
+              : std::make_shared<const RigidParticlePreconditioner>(
+                    system, map, force_scale, multilevel,
+                    multilevel ? &system.positions() : nullptr);  // as the cache builds it
     }
     // Over MPI processes each keeps only its blocks of the L-BFGS pairs (docs/mpi.md).
     if (options.distributed != nullptr) {

@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <stdexcept>
 #include <string>
+
+#include "mresim/mess/solvers/stiffness_terms.hpp"
 
 namespace mresim::mess {
 
@@ -123,7 +126,8 @@ constexpr int kNeighbours = kWidth * kWidth * kWidth;
 
 MultilevelCorrection::MultilevelCorrection(const lattice::Lattice& lattice,
                                            double volume_force_factor, const DofMap& map,
-                                           double force_scale, Eigen::Index exact_limit) {
+                                           double force_scale, const Eigen::Matrix3Xd* state,
+                                           Eigen::Index exact_limit) {
   if (exact_limit < 1) {
     throw std::invalid_argument("MultilevelCorrection: exact_limit " + std::to_string(exact_limit) +
                                 " must be at least 1");
@@ -131,7 +135,7 @@ MultilevelCorrection::MultilevelCorrection(const lattice::Lattice& lattice,
   fine_ = lattice.shape.nodes;
   own_dofs_ = map.own_dofs();
   build_levels(exact_limit);
-  assemble(lattice, volume_force_factor, lattice.element_length / force_scale, map);
+  assemble(lattice, volume_force_factor, lattice.element_length / force_scale, map, state);
 }
 
 Eigen::Index MultilevelCorrection::level_size(int level) const {
@@ -269,58 +273,59 @@ class LevelAssembler {
   std::vector<double> blocks_;
 };
 
-// The reference Hessian's rank-one terms: each spring at rest k e e^T on (x_j - x_i), e the rest
-// direction (eq. 4.62's Hessian); each cell f kappa g g^T / V0 with g_a = +-l_e^2 / 4 at each
-// vertex (as the diagonal of RigidParticlePreconditioner).
-void add_reference_hessian(const lattice::Lattice& lattice, double volume_force_factor,
-                           double scale, LevelAssembler& level) {
-  const Eigen::Matrix3Xd& x0 = lattice.positions;
-  const double l_e = lattice.element_length;
-  const lattice::SpringSet& sp = lattice.springs;
-  for (std::size_t s = 0; s < sp.size(); ++s) {
-    const std::int64_t i = sp.first[s];
-    const std::int64_t j = sp.second(s);
-    const Eigen::Vector3d e = (x0.col(j) - x0.col(i)).normalized();
-    level.clear();
-    level.add_node(j, e, 1.0);
-    level.add_node(i, e, -1.0);
-    level.add_term(sp.stiffness(s) * scale);
-  }
-  const double cell =
-      volume_force_factor * std::abs(lattice.polymer.kappa) / (l_e * l_e * l_e) * scale;
-  for (const auto& element : lattice.elements) {
-    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    for (const std::int32_t n : element) centre += x0.col(n);
-    centre /= 8.0;
-    level.clear();
-    for (const std::int32_t n : element) {
-      level.add_node(n, (x0.col(n) - centre).cwiseSign() * (l_e * l_e / 4.0), 1.0);
-    }
-    level.add_term(cell);
-  }
+// The stiffness terms of stiffness_terms.hpp, linearised at `state` (null: at rest), projected
+// onto one level.
+void add_stiffness(const lattice::Lattice& lattice, const Eigen::Matrix3Xd* state,
+                   const DofMap& map, double volume_force_factor, double scale,
+                   LevelAssembler& level) {
+  for_each_stiffness_term(
+      lattice, state, map, volume_force_factor, scale,
+      [&level](std::int64_t i, std::int64_t j, const Eigen::Vector3d& u, double c) {
+        level.clear();
+        level.add_node(j, u, 1.0);
+        level.add_node(i, u, -1.0);
+        level.add_term(c);
+      },
+      [&level](const auto& element, const lattice::CellVertices& g, double c) {
+        level.clear();
+        for (std::size_t v = 0; v < 8; ++v) level.add_node(element[v], g[v], 1.0);
+        level.add_term(c);
+      });
 }
 
 }  // namespace
 
 void MultilevelCorrection::assemble(const lattice::Lattice& lattice, double volume_force_factor,
-                                    double scale, const DofMap& map) {
-  for (std::size_t li = 0; li < levels_.size(); ++li) {
-    Level& level = levels_[li];
-    const bool exact = li + 1 == levels_.size();
-    const std::int64_t points = point_count(level.points);
-    LevelAssembler assembler({level.axes[0].plane, level.axes[1].plane, level.axes[2].plane}, fine_,
-                             level.points, map, exact);
-    add_reference_hessian(lattice, volume_force_factor, scale, assembler);
-    if (exact) {
-      factor_coarsest(level.points, assembler.diagonal(), assembler.blocks());
-      continue;
-    }
-    level.inverse_diagonal = Eigen::VectorXd::Zero(3 * points);
-    for (std::int64_t q = 0; q < 3 * points; ++q) {
-      const double d = assembler.diagonal()[static_cast<std::size_t>(q)];
-      if (d > 0.0) level.inverse_diagonal[q] = 1.0 / d;
+                                    double scale, const DofMap& map,
+                                    const Eigen::Matrix3Xd* state) {
+  // Each level sweeps all springs and cells, and the levels are independent: one thread per
+  // level, so that each level's sums come in the same order whatever the thread count.
+  std::exception_ptr failure;
+  const auto count = static_cast<std::int64_t>(levels_.size());
+#pragma omp parallel for schedule(dynamic, 1) if (point_count(fine_) >= 20000)
+  for (std::int64_t li = 0; li < count; ++li) {
+    try {
+      Level& level = levels_[static_cast<std::size_t>(li)];
+      const bool exact = li + 1 == count;
+      const std::int64_t points = point_count(level.points);
+      LevelAssembler assembler({level.axes[0].plane, level.axes[1].plane, level.axes[2].plane},
+                               fine_, level.points, map, exact);
+      add_stiffness(lattice, state, map, volume_force_factor, scale, assembler);
+      if (exact) {
+        factor_coarsest(level.points, assembler.diagonal(), assembler.blocks());
+        continue;
+      }
+      level.inverse_diagonal = Eigen::VectorXd::Zero(3 * points);
+      for (std::int64_t q = 0; q < 3 * points; ++q) {
+        const double d = assembler.diagonal()[static_cast<std::size_t>(q)];
+        if (d > 0.0) level.inverse_diagonal[q] = 1.0 / d;
+      }
+    } catch (...) {
+#pragma omp critical(mresim_multilevel_assembly)
+      failure = std::current_exception();
     }
   }
+  if (failure) std::rethrow_exception(failure);
 }
 
 void MultilevelCorrection::factor_coarsest(const std::array<int, 3>& p,

@@ -55,8 +55,11 @@ class MultilevelCorrection {
   // `volume_force_factor`: the volume term's force factor (MessSettings::elastic).
   // Throws std::invalid_argument if exact_limit < 1, std::runtime_error if the coarsest level
   // cannot be factored (no coordinate held, so A is singular: callers leave the correction out).
+  // `state`: the positions (3 x N, m) at which the springs and cells are linearised
+  // (stiffness_terms.hpp); null: the reference lattice.
   MultilevelCorrection(const lattice::Lattice& lattice, double volume_force_factor,
                        const DofMap& map, double force_scale,
+                       const Eigen::Matrix3Xd* state = nullptr,
                        Eigen::Index exact_limit = kDefaultExactLimit);
 
   // w += C v (v, w over the map's dofs). `map`: one with the same free coordinates as the
@@ -86,7 +89,7 @@ class MultilevelCorrection {
 
   void build_levels(Eigen::Index exact_limit);
   void assemble(const lattice::Lattice& lattice, double volume_force_factor, double scale,
-                const DofMap& map);
+                const DofMap& map, const Eigen::Matrix3Xd* state);
   // The coarsest level's matrix from its diagonal and neighbour blocks (LevelAssembler), and
   // its LDL^T; throws std::runtime_error if it is singular.
   void factor_coarsest(const std::array<int, 3>& points, const std::vector<double>& diagonal,

@@ -6,31 +6,40 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "mresim/mess/solvers/stiffness_terms.hpp"
 #include "mresim/mess/solvers/vector_algebra.hpp"
 
 namespace mresim::mess {
 
 RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& system,
                                                          const DofMap& map, double force_scale,
-                                                         bool multilevel) {
+                                                         bool multilevel,
+                                                         const Eigen::Matrix3Xd* state) {
   const lattice::Lattice& lat = system.lattice();
-  const Eigen::Matrix3Xd& x0 = lat.positions;
+  const Eigen::Matrix3Xd& x0 = state != nullptr ? *state : lat.positions;
   const double l_e = lat.element_length;
-  // Hessian diagonal per node coordinate (N/m) at the reference configuration.
+  const double volume_force_factor = system.settings().elastic.volume_force_factor;
+  // Hessian diagonal per node coordinate (N/m) of the stiffness terms (stiffness_terms.hpp).
   Eigen::Matrix3Xd d = Eigen::Matrix3Xd::Zero(3, lat.node_count());
-  const lattice::SpringSet& sp = lat.springs;
-  for (std::size_t s = 0; s < sp.size(); ++s) {
-    const Eigen::Vector3d e = (x0.col(sp.second(s)) - x0.col(sp.first[s])).normalized();
-    const Eigen::Vector3d h = sp.stiffness(s) * e.cwiseAbs2();
-    d.col(sp.first[s]) += h;
-    d.col(sp.second(s)) += h;
-  }
-  // Volume term: kappa V0 (dV/dx / V0)^2 with |dV/dx_a| = l_e^2/4 at rest, per cell.
-  const double cell =
-      system.settings().elastic.volume_force_factor * std::abs(lat.polymer.kappa) * l_e / 16.0;
-  for (const auto& e : lat.elements) {
-    for (const std::int32_t n : e) d.col(n).array() += cell;
-  }
+  // At rest the cells' diagonal is the one constant below (kept as it always was computed, so
+  // that a preconditioner built at rest has the same bits as before the states existed).
+  const double cell_at_rest = volume_force_factor * std::abs(lat.polymer.kappa) * l_e / 16.0;
+  for_each_stiffness_term(
+      lat, state, map, volume_force_factor, 1.0,
+      [&d](std::int64_t i, std::int64_t j, const Eigen::Vector3d& u, double c) {
+        const Eigen::Vector3d h = c * u.cwiseAbs2();
+        d.col(i) += h;
+        d.col(j) += h;
+      },
+      [&](const auto& element, const lattice::CellVertices& g, double c) {
+        for (std::size_t v = 0; v < 8; ++v) {
+          if (state == nullptr) {
+            d.col(element[v]).array() += cell_at_rest;
+          } else {
+            d.col(element[v]) += c * g[v].cwiseAbs2();
+          }
+        }
+      });
 
   // Per dof (group dofs: sum over the group's nodes), scaled.
   const double scale = l_e / force_scale;
@@ -87,8 +96,8 @@ RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& syste
   }
   if (multilevel) {
     try {
-      multilevel_ = std::make_unique<MultilevelCorrection>(
-          lat, system.settings().elastic.volume_force_factor, map, force_scale);
+      multilevel_ =
+          std::make_unique<MultilevelCorrection>(lat, volume_force_factor, map, force_scale, state);
     } catch (const std::runtime_error&) {
       multilevel_.reset();  // nothing held: the coarse Hessian is singular (header)
     }
@@ -154,7 +163,15 @@ std::uint64_t preconditioner_key(const MessSystem& system, const DofMap& map, do
 std::shared_ptr<const RigidParticlePreconditioner> PreconditionerCache::get(
     const MessSystem& system, const DofMap& map, double force_scale, bool multilevel) {
   const std::uint64_t key = preconditioner_key(system, map, force_scale, multilevel);
-  if (kept_ == nullptr || lattice_ != &system.lattice() || key != key_) {
+  if (multilevel) {
+    kept_.reset();  // before the new one is built: never two at once
+    kept_ = std::make_shared<const RigidParticlePreconditioner>(system, map, force_scale, true,
+                                                                &system.positions());
+    lattice_ = &system.lattice();
+    key_ = key;
+    ++builds_;
+  } else if (kept_ == nullptr || lattice_ != &system.lattice() || key != key_) {
+    kept_.reset();
     kept_ =
         std::make_shared<const RigidParticlePreconditioner>(system, map, force_scale, multilevel);
     lattice_ = &system.lattice();

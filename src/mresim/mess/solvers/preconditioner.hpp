@@ -13,19 +13,23 @@
 //   P = D^-1                                   on dofs outside fully free particles,
 //   P = (I - Q Q^T) D^-1 (I - Q Q^T) + Q Q^T / h   on each fully free particle's 3 n_p dofs,
 //
-// with D the Hessian diagonal of springs and volume term at the reference configuration
-// (springs: sum k e_a^2 over a node's springs, e the rest direction; volume: force factor x
-// kappa l_e / 16 per cell at the node), Q an orthonormal basis of the particle's 6 rigid motions
-// (3 translations, 3 rotations about its centre) and h the mean polymer diagonal (the rigid
-// modes are resisted by the polymer alone). P is symmetric positive definite.
+// with D the diagonal of the springs' and cells' stiffness terms linearised at a state
+// (stiffness_terms.hpp; at rest: springs sum k e_a^2 over a node's springs, e the rest direction;
+// volume force factor x kappa l_e / 16 per cell at the node), Q an orthonormal basis of the
+// particle's 6 rigid motions (3 translations, 3 rotations about its centre) and h the mean
+// polymer diagonal (the rigid modes are resisted by the polymer alone). P is symmetric positive
+// definite.
 //
 // With `multilevel`, P + C: the additive correction over coarse grids of the lattice
 // (multilevel_correction.hpp), which carries the polymer's long and middle waves that the
 // diagonal leaves slow. Also symmetric positive definite. Where the lattice holds no coordinate
 // (so C would be singular) it is left out.
 //
-// Everything here depends only on the lattice, the free coordinates and the force scale, so a
-// run relaxing many steps keeps one (PreconditionerCache) while its free coordinates stay.
+// Built at rest (the reference lattice), P depends only on the lattice, the free coordinates and
+// the force scale, so a run relaxing many steps keeps one (PreconditionerCache) while its free
+// coordinates stay: the plain P of `method = "lbfgs"` and of small lattices. With the multilevel
+// correction it is built at each relaxation's starting state instead (PreconditionerCache::get):
+// large lattices are where particles in contact deform the polymer far from its rest shape.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -42,8 +46,10 @@ class RigidParticlePreconditioner {
  public:
   // Diagonal from the lattice's springs and cells; scaled like the minimiser's variables
   // (gradient in units of force_scale per l_e): D_scaled = D l_e / force_scale.
+  // `state`: the positions (3 x N, m) at which springs and cells are linearised
+  // (stiffness_terms.hpp) and the particles' rigid motions taken; null: the reference lattice.
   RigidParticlePreconditioner(const MessSystem& system, const DofMap& map, double force_scale,
-                              bool multilevel = false);
+                              bool multilevel = false, const Eigen::Matrix3Xd* state = nullptr);
 
   // P v. `map`: one with the same free coordinates and groups as the constructor's (as
   // PreconditionerCache hands out); the multilevel correction reads the lattice through it.
@@ -63,11 +69,14 @@ class RigidParticlePreconditioner {
   std::unique_ptr<MultilevelCorrection> multilevel_;
 };
 
-// A run's preconditioner, kept across its relaxations: rebuilt only when what it depends on
-// changes (the free coordinates and rigid groups, the force scale, the multilevel choice).
+// A run's preconditioner, kept across its relaxations. Without the multilevel correction it is
+// built at rest and rebuilt only when what it depends on changes (the free coordinates and rigid
+// groups, the force scale, the multilevel choice). With it, every get() builds a new one at the
+// system's positions (the starting state of the relaxation that asks), after releasing the kept
+// one, so that two are never held at once (peak memory).
 class PreconditionerCache {
  public:
-  // The preconditioner for these arguments: the kept one if they match it, else a new one.
+  // The preconditioner for these arguments (see above).
   std::shared_ptr<const RigidParticlePreconditioner> get(const MessSystem& system,
                                                          const DofMap& map, double force_scale,
                                                          bool multilevel);
