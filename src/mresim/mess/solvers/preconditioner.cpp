@@ -16,7 +16,8 @@ RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& syste
                                                          bool multilevel,
                                                          const Eigen::Matrix3Xd* state) {
   const lattice::Lattice& lat = system.lattice();
-  const Eigen::Matrix3Xd& x0 = state != nullptr ? *state : lat.positions;
+  // Where the particles' rigid motions are taken: the state, or the reference lattice.
+  const Eigen::Matrix3Xd& x = state != nullptr ? *state : lat.positions;
   const double l_e = lat.element_length;
   const double volume_force_factor = system.settings().elastic.volume_force_factor;
   // Hessian diagonal per node coordinate (N/m) of the stiffness terms (stiffness_terms.hpp).
@@ -79,11 +80,11 @@ RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& syste
     if (!free) continue;
     const auto np = static_cast<Eigen::Index>(nodes.size());
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    for (const std::int32_t n : nodes) centre += x0.col(n);
+    for (const std::int32_t n : nodes) centre += x.col(n);
     centre /= static_cast<double>(np);
     Eigen::MatrixXd r = Eigen::MatrixXd::Zero(3 * np, 6);
     for (Eigen::Index i = 0; i < np; ++i) {
-      const Eigen::Vector3d p = (x0.col(nodes[static_cast<std::size_t>(i)]) - centre) / l_e;
+      const Eigen::Vector3d p = (x.col(nodes[static_cast<std::size_t>(i)]) - centre) / l_e;
       r.block<3, 3>(3 * i, 0).setIdentity();
       // Rotation about axis c: omega_c x p.
       r.block<3, 1>(3 * i, 3) = Eigen::Vector3d::UnitX().cross(p);
