@@ -51,6 +51,13 @@ TEST(MessOutputs, ResultsSummaryAndXdmfAreConsistent) {
   EXPECT_GT(per_node, 24.0);
   EXPECT_NEAR(per_node * static_cast<double>(h5.shape("/lattice/initial_positions")[0]), peak,
               1e-6 * peak);
+  // Per step, the peak so far: positive, never falling, and the last one at most the run's
+  // (the run's is measured later, after the outputs were written).
+  const auto step_peaks = h5.ints("/steps/solver/peak_resident_memory");
+  ASSERT_EQ(step_peaks.size(), steps);
+  EXPECT_GT(step_peaks.front(), 0);
+  for (std::size_t s = 1; s < steps; ++s) EXPECT_GE(step_peaks[s], step_peaks[s - 1]) << s;
+  EXPECT_LE(static_cast<double>(step_peaks.back()), peak);
   // The energy terms add up to the total (self_linearized is reported only).
   const auto total = h5.doubles("/steps/energies/total");
   for (std::size_t s = 0; s < steps; ++s) {

@@ -239,8 +239,8 @@ TEST(MessMemory, EstimateIsFixedPlusPerNodePlusDenseMagnetization) {
   large.solver.method = mc::SolverMethod::lbfgs;
   EXPECT_EQ(mc::estimated_memory_bytes(large),
             mc::kFixedBytes + 40000 * mc::kBytesPerNode + 32 * 36);
-  // A strain run keeps the latest state and the zero-load reference of every field (48 bytes
-  // per node per field) for its whole length.
+  // A strain run keeps the latest state and the zero-load reference of every field for its
+  // whole length, on disk (48 bytes per node per field), not in memory.
   const std::string strain =
       edit(edit(kAnisotropic, "type = \"mess_hysteresis\"", "type = \"mess_strain\""),
            "[field]\nmax = 0.05\nsteps = 1\n",
@@ -248,9 +248,10 @@ TEST(MessMemory, EstimateIsFixedPlusPerNodePlusDenseMagnetization) {
            "\"z\"\ndirection = \"x\"\nmax = 0.02\nsteps = 2\n");
   const mc::MessSpec sheared = spec_of(strain);
   ASSERT_EQ(sheared.load_step_count(), 3U);
-  EXPECT_EQ(
-      mc::estimated_memory_bytes(sheared),
-      mc::kFixedBytes + 3700 * (mc::kBytesPerNode + 3 * mc::kPerFieldStateBytesPerNode) + 32 * 36);
+  EXPECT_EQ(mc::estimated_memory_bytes(sheared),
+            mc::kFixedBytes + 3700 * mc::kBytesPerNode + 32 * 36);
+  EXPECT_EQ(mc::scratch_bytes_per_node(sheared), 3 * mc::kPerFieldScratchBytesPerNode);
+  EXPECT_EQ(mc::scratch_bytes_per_node(spec), 0);
   EXPECT_NO_THROW(mc::check_memory(spec, {std::nullopt, "unknown"}));
   try {
     mc::check_memory(spec, {1'000'000, "test"});

@@ -49,12 +49,13 @@ void write_checkpoint(const fs::path& file, const ProtocolState& state,
     out.write_int_attribute("/", "slots", static_cast<std::int64_t>(state.slots.size()));
     out.write_int_attribute("/", "references", static_cast<std::int64_t>(state.references.size()));
     for (std::size_t i = 0; i < state.slots.size(); ++i) {
-      write_optional(out, fmt::format("/slots/{}/positions", i), state.slots[i].positions, "m");
+      write_optional(out, fmt::format("/slots/{}/positions", i), state.slots[i].positions.load(),
+                     "m");
       write_optional(out, fmt::format("/slots/{}/magnetization", i), state.slots[i].magnetization,
                      "A/m");
     }
     for (std::size_t i = 0; i < state.references.size(); ++i) {
-      write_optional(out, fmt::format("/references/{}", i), state.references[i], "m");
+      write_optional(out, fmt::format("/references/{}", i), state.references[i].load(), "m");
     }
     if (!state.records.empty()) {
       write_step_records(out, "/records", state.records, runner.system().particle_count(),
@@ -88,9 +89,11 @@ ProtocolState read_checkpoint(const fs::path& file, const ProtocolRunner& runner
     state.slots[i].positions = read_optional(in, fmt::format("/slots/{}/positions", i), nodes);
     state.slots[i].magnetization =
         read_optional(in, fmt::format("/slots/{}/magnetization", i), particles);
+    runner.park_kept_positions(state);  // one field's array in memory at a time, at most
   }
   for (std::size_t i = 0; i < state.references.size(); ++i) {
     state.references[i] = read_optional(in, fmt::format("/references/{}", i), nodes);
+    runner.park_kept_positions(state);
   }
   if (next > 0) {
     state.records =

@@ -131,6 +131,8 @@ void write_step_records(io::Hdf5File& file, const std::string& group,
   file.write_vector(s + "magnetization_residual",
                     column(records, [](auto& r) { return r.magnetization_residual; }), "1");
   file.write_vector(s + "wall_time", column(records, [](auto& r) { return r.wall_time; }), "s");
+  file.write_int_vector(s + "peak_resident_memory",
+                        int_column(records, [](auto& r) { return r.peak_resident_memory; }), "B");
 }
 
 std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std::string& group,
@@ -196,6 +198,10 @@ std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std:
   const std::vector<std::int64_t> m_iterations = ints(s + "magnetization_iterations");
   const std::vector<double> m_residual = doubles(s + "magnetization_residual");
   const std::vector<double> wall = doubles(s + "wall_time");
+  // Absent in files written before the peak memory was recorded per step: 0.
+  const std::vector<std::int64_t> peak_memory = file.exists(s + "peak_resident_memory")
+                                                    ? ints(s + "peak_resident_memory")
+                                                    : std::vector<std::int64_t>(n, 0);
   if (status.size() != n || method.size() != n || finished_by.size() != n) {
     throw std::runtime_error("inconsistent solver data in " + group);
   }
@@ -222,6 +228,7 @@ std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std:
     r.magnetization_iterations = m_iterations[i];
     r.magnetization_residual = m_residual[i];
     r.wall_time = wall[i];
+    r.peak_resident_memory = peak_memory[i];
   }
   return records;
 }

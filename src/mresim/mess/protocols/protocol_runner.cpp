@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "mresim/app/peak_memory.hpp"
 #include "mresim/core/constants.hpp"
 #include "mresim/mess/analysis/box_strain.hpp"
 #include "mresim/mess/lattice/volume_elements.hpp"
@@ -69,6 +70,15 @@ ProtocolState ProtocolRunner::initial_state() const {
   return state;
 }
 
+void ProtocolRunner::park_kept_positions(ProtocolState& state) const {
+  if (scratch_directory_.empty() || state.slots.size() <= 1) return;
+  if (!state.spill) {
+    state.spill = std::make_shared<PositionsSpill>(scratch_directory_, system_.node_count());
+  }
+  for (SlotState& slot : state.slots) slot.positions.park(state.spill);
+  for (KeptPositions& reference : state.references) reference.park(state.spill);
+}
+
 const SlotState* ProtocolRunner::start_state(const StepSpec& step,
                                              const ProtocolState& state) const {
   if (step.load_index > 0) return &state.slots[slot_of_field(step.field_index)];
@@ -108,8 +118,10 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   // from the zero-load state at this field.
   const Protocol& protocol = *spec_.protocol;
   const bool loaded = step.load_index > 0 && protocol.loads_from_zero_load_state();
-  const Eigen::Matrix3Xd& reference = loaded ? state.references[step.field_index] : lat.positions;
-  LoadState load = protocol.load(lat, step, reference);
+  // The zero-load reference, read (from memory or the scratch file) where it is needed and not
+  // held while the step relaxes: with many fields it may be parked.
+  const auto reference_of_field = [&] { return state.references[step.field_index].load(); };
+  LoadState load = protocol.load(lat, step, loaded ? reference_of_field() : lat.positions);
 
   const SlotState* start = start_state(step, state);
   SlotState& slot = state.slots[slot_of_field(step.field_index)];
@@ -120,12 +132,14 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
     // the system takes the positions over instead of copying them, 24 bytes per node less
     // while it relaxes. The slot is written again below; if the step throws, the run ends and
     // resumes from its last checkpoint.
-    system_.set_positions(std::move(slot.positions));
-    slot.positions.resize(3, 0);
+    system_.set_positions(slot.positions.take());
   } else {
-    system_.set_positions(start != nullptr && start->positions.cols() > 0 ? start->positions
+    system_.set_positions(start != nullptr && start->positions.cols() > 0 ? start->positions.load()
                                                                           : lat.positions);
   }
+  // The system holds the start now: every kept array can wait in the scratch file while the
+  // step relaxes (the step's own slot and reference are written again below).
+  park_kept_positions(state);
   if (start != nullptr && start->magnetization.cols() > 0) {
     system_.set_magnetizations(start->magnetization);
   }
@@ -179,9 +193,9 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   record.magnetization = system_.magnetizations();
   record.system_volume = system_volume(lat, system_.positions());
   record.box_strain = mess_analysis::box_strain(lat, system_.positions());
-  const Eigen::Matrix3Xd& zero_load =
-      step.load_index > 0 ? state.references[step.field_index] : system_.positions();
-  record.measured_strain = protocol.measured_strain(lat, step, system_.positions(), zero_load);
+  record.measured_strain =
+      protocol.measured_strain(lat, step, system_.positions(),
+                               step.load_index > 0 ? reference_of_field() : system_.positions());
 
   // Advance the state.
   slot.positions = system_.positions();
@@ -191,6 +205,7 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   }
   record.wall_time =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  record.peak_resident_memory = app::peak_resident_memory_bytes();
   state.records.push_back(std::move(record));
   ++state.next_step;
   return state.records.back();

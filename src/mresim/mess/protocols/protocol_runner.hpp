@@ -19,12 +19,14 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "mresim/mess/protocols/kept_positions.hpp"
 #include "mresim/mess/protocols/step_plan.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
 #include "mresim/mess/solvers/newton.hpp"
@@ -69,19 +71,26 @@ struct StepRecord {
   std::int64_t magnetization_iterations = 0;
   double magnetization_residual = 0.0;  // of the final solve, units of Ms
   double wall_time = 0.0;               // s
+  // The process's peak resident memory so far (app::peak_resident_memory_bytes) when the step
+  // ended, bytes; 0 where not recorded. A run resumed from a checkpoint counts from its resume.
+  std::int64_t peak_resident_memory = 0;
 };
 
 // The latest converged state at one field (or of the previous step; see above).
 struct SlotState {
-  Eigen::Matrix3Xd positions;      // 0 columns: the initial lattice
+  KeptPositions positions;         // 0 columns: the initial lattice
   Eigen::Matrix3Xd magnetization;  // 0 columns: no history
 };
 
 struct ProtocolState {
   std::size_t next_step = 0;
-  std::vector<SlotState> slots;              // one per field for strain/stress runs, else one
-  std::vector<Eigen::Matrix3Xd> references;  // zero-load result per field (0 columns: unset)
-  std::vector<StepRecord> records;           // of steps 0 .. next_step - 1
+  std::vector<SlotState> slots;           // one per field for strain/stress runs, else one
+  std::vector<KeptPositions> references;  // zero-load result per field (0 columns: unset)
+  std::vector<StepRecord> records;        // of steps 0 .. next_step - 1
+  // Where the positions of the fields a step does not work on are parked (kept_positions.hpp);
+  // null: all in memory. ProtocolRunner::run_next_step creates it when the runner has a
+  // scratch directory (set_scratch_directory) and the state has more than one slot.
+  std::shared_ptr<PositionsSpill> spill;
 };
 
 class ProtocolRunner {
@@ -106,6 +115,20 @@ class ProtocolRunner {
   void set_relaxation_observer(mess::RelaxationObserver observer) {
     observer_ = std::move(observer);
   }
+  // Strain and stress runs park the positions of the fields a step does not work on in an
+  // unnamed scratch file in `directory` (kept_positions.hpp), so that their memory does not
+  // grow with the number of fields; empty (the default): everything stays in memory. The
+  // results are the same either way, bit for bit.
+  void set_scratch_directory(std::filesystem::path directory) {
+    scratch_directory_ = std::move(directory);
+  }
+
+  // Parks every slot's positions and every reference of `state` in state.spill (created on
+  // first use) when the runner has a scratch directory and the state more than one slot; else
+  // nothing. run_next_step calls it once the system holds the step's start, read_checkpoint
+  // after each array it reads.
+  void park_kept_positions(ProtocolState& state) const;
+
   // Every relaxation's evaluations split over the evaluator's MPI processes, each of which runs
   // the same steps on its own runner at the same time (MinimiserOptions::distributed).
   void set_distributed(std::shared_ptr<mess::DistributedEvaluator> evaluator) {
@@ -126,8 +149,10 @@ class ProtocolRunner {
   // L-BFGS's preconditioner, built at the first step and kept while the free coordinates stay.
   std::shared_ptr<mess::PreconditionerCache> preconditioner_cache_ =
       std::make_shared<mess::PreconditionerCache>();
+
   mess::RelaxationObserver observer_;
   std::shared_ptr<mess::DistributedEvaluator> distributed_;
+  std::filesystem::path scratch_directory_;
 };
 
 // Sum of the cell volumes (m^3) at positions x.

@@ -34,12 +34,12 @@ void take_final_state(const ProtocolState& final, const std::vector<StepSpec>& s
   }
   for (std::size_t s = 0; s < last_in_slot.size(); ++s) {
     if (last_in_slot[s] && final.slots[s].positions.cols() > 0) {
-      positions[*last_in_slot[s]] = final.slots[s].positions;
+      positions[*last_in_slot[s]] = final.slots[s].positions.load();
     }
   }
   for (std::size_t f = 0; f < reference_step.size(); ++f) {
     if (reference_step[f] && final.references[f].cols() > 0) {
-      positions[*reference_step[f]] = final.references[f];
+      positions[*reference_step[f]] = final.references[f].load();
     }
   }
 }

@@ -288,12 +288,15 @@ void describe_solver(const MessSpec& s, app::InfoReport& r) {
 void describe_memory(const MessSpec& s, app::InfoReport& r) {
   constexpr double kMiB = 1 << 20;
   r.add("memory", "estimate", static_cast<double>(estimated_memory_bytes(s)) / kMiB, "MiB",
-        fmt::format("{:.0f} MiB + {} bytes per node{} + 32 (3N)^2 bytes for N particles",
-                    static_cast<double>(kFixedBytes) / kMiB, bytes_per_node(s),
-                    per_field_bytes_per_node(s) > 0
-                        ? fmt::format(" + {} per node for {} fields' states",
-                                      per_field_bytes_per_node(s), s.field.values.size())
-                        : ""));
+        fmt::format("{:.0f} MiB + {} bytes per node + 32 (3N)^2 bytes for N particles",
+                    static_cast<double>(kFixedBytes) / kMiB, bytes_per_node(s)));
+  if (scratch_bytes_per_node(s) > 0) {
+    r.add("memory", "scratch_disk",
+          static_cast<double>(scratch_bytes_per_node(s) * s.geometry.node_count()) / kMiB, "MiB",
+          fmt::format("{} bytes per node: the {} fields' latest and zero-load states, kept in an "
+                      "unnamed scratch file beside the results while other fields run",
+                      scratch_bytes_per_node(s), s.field.values.size()));
+  }
   const AvailableMemory available = available_memory();
   if (available.bytes) {
     r.add("memory", "available", static_cast<double>(*available.bytes) / kMiB, "MiB",

@@ -62,19 +62,17 @@ std::int64_t bytes_per_node(const MessSpec& spec) {
   return spec.solver.method == SolverMethod::newton ? kNewtonBytesPerNode : kBytesPerNode;
 }
 
-std::int64_t per_field_bytes_per_node(const MessSpec& spec) {
+std::int64_t scratch_bytes_per_node(const MessSpec& spec) {
   return spec.load_step_count() > 1
-             ? kPerFieldStateBytesPerNode * static_cast<std::int64_t>(spec.field.values.size())
+             ? kPerFieldScratchBytesPerNode * static_cast<std::int64_t>(spec.field.values.size())
              : 0;
 }
 
 std::int64_t estimated_memory_bytes(const MessSpec& spec) {
   const auto nodes = static_cast<double>(spec.geometry.node_count());
   const auto dim = 3.0 * static_cast<double>(spec.geometry.particle_count());
-  const double bytes =
-      static_cast<double>(kFixedBytes) +
-      static_cast<double>(bytes_per_node(spec) + per_field_bytes_per_node(spec)) * nodes +
-      4.0 * 8.0 * dim * dim;
+  const double bytes = static_cast<double>(kFixedBytes) +
+                       static_cast<double>(bytes_per_node(spec)) * nodes + 4.0 * 8.0 * dim * dim;
   const auto top = static_cast<double>(std::numeric_limits<std::int64_t>::max());
   return bytes >= top ? std::numeric_limits<std::int64_t>::max() : static_cast<std::int64_t>(bytes);
 }

@@ -302,14 +302,16 @@ inline constexpr std::int64_t kFixedBytes = 32LL << 20;
 
 // Strain and stress runs (more than one load value) keep two states per field for the run's
 // whole length: the latest one, which the field's next load step starts from, and the
-// zero-load reference its loads are measured from (ProtocolState: two 3 x nodes arrays of
-// doubles). Measured: the full-size Fig. 4.25 helix (993,168 nodes) peaked at 990 bytes per
-// node after its first three fields, and each further field adds these 48.
-inline constexpr std::int64_t kPerFieldStateBytesPerNode = 48;
-// kPerFieldStateBytesPerNode x fields for runs with more than one load value, else 0.
-std::int64_t per_field_bytes_per_node(const MessSpec& spec);
+// zero-load reference its loads are measured from (two 3 x nodes arrays of doubles). They wait
+// in an unnamed scratch file beside the results, not in memory (protocols/kept_positions.hpp):
+// measured in memory, the full-size Fig. 4.25 helix (993,168 nodes) grew by these 48 bytes per
+// node with every field.
+inline constexpr std::int64_t kPerFieldScratchBytesPerNode = 48;
+// The scratch file's size per node at the end of the run: kPerFieldScratchBytesPerNode x fields
+// for runs with more than one load value, else 0. On disk; not part of the memory estimate.
+std::int64_t scratch_bytes_per_node(const MessSpec& spec);
 
-// kFixedBytes + (bytes_per_node + per_field_bytes_per_node) x nodes + the magnetization solve's
+// kFixedBytes + bytes_per_node x nodes + the magnetization solve's
 // dense 3N x 3N matrices (Hessian, its factorization, the eigen-decomposition and Anderson's
 // history: 4 x 8 (3N)^2 bytes for N particles).
 std::int64_t estimated_memory_bytes(const MessSpec& spec);

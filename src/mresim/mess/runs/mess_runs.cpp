@@ -67,6 +67,9 @@ class MessPlan final : public app::RunPlan {
     pair::runs::print_warnings(spec_.warnings);
     progress.note(setup_line());
     ProtocolRunner runner(spec_);
+    // Strain and stress runs keep the fields they are not working on in an unnamed scratch
+    // file beside the results (kept_positions.hpp), not in memory.
+    runner.set_scratch_directory(staging_dir);
     const fs::path checkpoint = staging_dir / kCheckpointFile;
     const bool split = split_over_processes(runner);
     ProtocolState state = fs::exists(checkpoint) ? read_checkpoint(checkpoint, runner, input_toml_)
@@ -140,6 +143,9 @@ class MessPlan final : public app::RunPlan {
   void participate(const fs::path& staging_dir) const override {
     ProtocolRunner runner(spec_);
     (void)split_over_processes(runner);
+    // As execute() does; a process without the staging directory uses the temporary directory
+    // (TMPDIR).
+    runner.set_scratch_directory(staging_dir.empty() ? fs::temp_directory_path() : staging_dir);
     const fs::path checkpoint = staging_dir.empty() ? fs::path() : staging_dir / kCheckpointFile;
     ProtocolState state = !checkpoint.empty() && fs::exists(checkpoint)
                               ? read_checkpoint(checkpoint, runner, input_toml_)
