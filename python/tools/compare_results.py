@@ -8,7 +8,7 @@ examples/chapter4/small/*.toml run with `mresim run FILE --out BEFORE/<name> --t
 builds). Every dataset of BEFORE/<name>/results.h5 is compared with the same dataset in AFTER:
 floating-point ones bitwise (NaN equal to NaN), and the largest difference relative to the
 dataset's largest magnitude is printed when they differ; others must be equal. Wall-clock times
-(datasets ending in wall_time) are skipped. Exit status 1 if anything differs or is missing.
+and memory (datasets ending in wall_time or peak_resident_memory) are skipped. Exit status 1 if anything differs or is missing.
 A refactoring that keeps the order of floating-point operations must print 0 differing datasets.
 """
 import os
@@ -21,7 +21,8 @@ import numpy as np
 def compare_file(name, before, after, tally, problems):
     with h5py.File(before) as a, h5py.File(after) as b:
         def visit(path, obj):
-            if not isinstance(obj, h5py.Dataset) or path.endswith("wall_time"):
+            if not isinstance(obj, h5py.Dataset) or path.endswith(("wall_time",
+                                                                    "peak_resident_memory")):
                 return
             if path not in b:
                 problems.append(f"{name}:{path} missing in {after}")

@@ -10,7 +10,8 @@ from conftest import MESS_DICT, PAIR_TOML
 
 # Differ from run to run by design: when and how long, not what.
 RUN_DEPENDENT = {"created_utc", "wall_time", "input_file", "command_line",
-                 "peak_resident_memory_bytes", "peak_resident_memory_bytes_per_node"}
+                 "peak_resident_memory_bytes", "peak_resident_memory_bytes_per_node",
+                 "peak_resident_memory"}
 
 
 def h5_contents(path):
