@@ -7,7 +7,8 @@
 // of the final states; then the exponent p of time ~ N^p fitted over n_d = 2 ... 5 and the
 // time ratios measured in this run. Methods: newton, lbfgs (rigid-particle preconditioner:
 // run files' method = "lbfgs"), minimiser (the same L-BFGS with the multilevel preconditioner,
-// LbfgsPreconditioner::multilevel: the run files' default above kMultilevelMinimumNodes),
+// LbfgsPreconditioner::multilevel: the run files' default above kMultilevelMinimumNodes, with
+// its pairs in single precision; minimiser-d the same with them in double precision),
 // lbfgs-mg (L-BFGS with Newton's multigrid as its initial inverse Hessian,
 // LbfgsPreconditioner::multigrid) and, for the seed profile, lbfgs-exact (its correction passes
 // each resolved to the force tolerance: MinimiserOptions::correction_forcing = 0, against the
@@ -92,12 +93,14 @@ struct Outcome {
 
 Outcome relax(const mess::ModelProfile& profile, int order, mess::MinimiserMethod method,
               mess::LbfgsPreconditioner preconditioner = mess::LbfgsPreconditioner::rigid_particles,
-              double correction_forcing = mess::MinimiserOptions{}.correction_forcing) {
+              double correction_forcing = mess::MinimiserOptions{}.correction_forcing,
+              mess::LbfgsHistoryPrecision history = mess::LbfgsHistoryPrecision::automatic) {
   mess::MessSystem sys = make_system(profile, order);
   mess::MinimiserOptions options;
   options.method = method;
   options.lbfgs_preconditioner = preconditioner;
   options.correction_forcing = correction_forcing;
+  options.lbfgs_history = history;
   Outcome o;
   const auto start = std::chrono::steady_clock::now();
   const double cpu0 = cpu_seconds();
@@ -251,6 +254,13 @@ int main(int argc, char** argv) {
       print(order, nodes, "minimiser", ml);
       print_against("minimiser", ml, "lbfgs", l);
       if (order >= 2) minimiser_fit.push_back(ml.wall);
+      // The same with the pairs in double precision (the minimiser's own are single).
+      const Outcome md =
+          relax(profile, order, mess::MinimiserMethod::lbfgs, mess::LbfgsPreconditioner::multilevel,
+                mess::MinimiserOptions{}.correction_forcing,
+                mess::LbfgsHistoryPrecision::double_precision);
+      print(order, nodes, "minimiser-d", md);
+      print_against("minimiser", ml, "minimiser-d", md);
       if (profile_name == "seed") {  // only the seed profile has correction passes
         const Outcome e = relax(profile, order, mess::MinimiserMethod::lbfgs,
                                 mess::LbfgsPreconditioner::rigid_particles, 0.0);

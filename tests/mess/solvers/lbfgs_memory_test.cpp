@@ -1,7 +1,8 @@
 // The L-BFGS memory (lbfgs_memory.hpp): its blocked, fused two-loop recursion gives the product
 // of the textbook serial recursion (to rounding), bitwise the same for any number of threads;
 // pairs without positive curvature are refused, the oldest pair goes beyond the capacity, and
-// H0's scale costs one preconditioner application per new pair.
+// H0's scale costs one preconditioner application per new pair. Pairs stored in single
+// precision give the recursion of the rounded pairs.
 
 #include "mresim/mess/solvers/lbfgs_memory.hpp"
 
@@ -51,7 +52,10 @@ Eigen::VectorXd serial_two_loop(const std::vector<Pair>& pairs, const Eigen::Vec
 // A memory of `count` pairs with y = A s for a diagonal A > 0 (positive curvature), over n
 // unknowns, the pairs added as L-BFGS adds them (s = alpha d, y = g_new - g_old).
 struct Fixture {
-  explicit Fixture(Eigen::Index n, int count, int capacity) : random(7) {
+  explicit Fixture(Eigen::Index n, int count, int capacity,
+                   LbfgsPrecision precision = LbfgsPrecision::double_precision)
+      : random(7) {
+    memory.set_precision(precision);
     const Eigen::VectorXd curvature = random_vector(n, random).cwiseAbs().array() + 0.5;
     p_diagonal = curvature.cwiseInverse();
     for (int k = 0; k < count; ++k) {
@@ -96,6 +100,46 @@ TEST(LbfgsMemory, TwoLoopAgreesWithTheSerialRecursionOnEveryThreadCount) {
       }
     }
     omp_set_num_threads(threads_before);
+  }
+}
+
+// Pairs stored in single precision: the product is the recursion of the stored (rounded)
+// pairs, to double rounding, on every thread count bitwise the same; it stays within single
+// rounding of the double-precision product, and the pairs take half the bytes.
+TEST(LbfgsMemory, SinglePrecisionIsTheRecursionOfTheRoundedPairs) {
+  for (const Eigen::Index n : {Eigen::Index{50}, kParallelMinimum + 4097}) {
+    Fixture f(n, 14, 10, LbfgsPrecision::single_precision);
+    const Fixture exact(n, 14, 10);
+    ASSERT_EQ(f.memory.size(), 10);
+    EXPECT_EQ(f.memory.stored_entries(), 20 * n);
+    EXPECT_EQ(2 * f.memory.stored_bytes(), exact.memory.stored_bytes());
+    std::vector<Pair> rounded = f.pairs;
+    for (Pair& p : rounded) {
+      p.s = p.s.cast<float>().cast<double>();
+      p.y = p.y.cast<float>().cast<double>();
+    }
+    const Eigen::VectorXd g = random_vector(n, f.random);
+    const Eigen::VectorXd expected = serial_two_loop(rounded, g, f.p_diagonal);
+    const Eigen::VectorXd unrounded = serial_two_loop(f.pairs, g, f.p_diagonal);
+    // The rounding is visible, and small.
+    EXPECT_GT((expected - unrounded).norm(), 1e-12 * unrounded.norm());
+    EXPECT_LE((expected - unrounded).norm(), 1e-5 * unrounded.norm());
+    const int threads_before = omp_get_max_threads();
+    Eigen::VectorXd first;
+    for (const int threads : {1, 2, 3, 8}) {
+      omp_set_num_threads(threads);
+      const Eigen::VectorXd product = f.memory.times(g, f.preconditioner);
+      EXPECT_LE((product - expected).norm(), 1e-12 * expected.norm()) << n << " " << threads;
+      if (threads == 1) {
+        first = product;
+      } else {
+        EXPECT_TRUE(product == first) << "not bitwise the same with " << threads << " threads";
+      }
+    }
+    omp_set_num_threads(threads_before);
+    // A new precision clears the memory.
+    f.memory.set_precision(LbfgsPrecision::double_precision);
+    EXPECT_TRUE(f.memory.empty());
   }
 }
 

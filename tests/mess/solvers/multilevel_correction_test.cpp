@@ -360,10 +360,15 @@ TEST(PreconditionerCache, KeepsThePlainOneAndBuildsTheMultilevelOneAtEachState) 
   EXPECT_NE(deformed->apply(other, v), at_rest->apply(other, v));
 }
 
-// L-BFGS with the multilevel preconditioner reaches the state L-BFGS reaches without it: a
-// pair drawn together at 100 mT (physical profile, all faces held), both to 1e-9 k_eff l_e.
+// L-BFGS with the multilevel preconditioner (and, by default with it, its pairs in single
+// precision) reaches the state L-BFGS reaches without it: a pair drawn together at 100 mT
+// (physical profile, all faces held), both to 1e-9 k_eff l_e. So does the multilevel
+// preconditioner with the pairs in double precision, and the rigid-particle one with them in
+// single precision.
 TEST(MultilevelCorrection, MinimiserReachesTheSameStateWithIt) {
-  const auto relax = [](mess::LbfgsPreconditioner preconditioner) {
+  const auto relax = [](mess::LbfgsPreconditioner preconditioner,
+                        mess::LbfgsHistoryPrecision history =
+                            mess::LbfgsHistoryPrecision::automatic) {
     const mess::ModelProfile& profile = mess::model_profile("physical");
     mess::MessSystem sys = mess::MessSystem::make(
         small_lattice(profile, {9, 9, 14}, {{4, 4, 4}, {4, 4, 9}}), tesla(0.0, 0.0, 0.1), profile);
@@ -375,6 +380,7 @@ TEST(MultilevelCorrection, MinimiserReachesTheSameStateWithIt) {
     mess::MinimiserOptions options;
     options.force_tolerance = 1e-9;
     options.lbfgs_preconditioner = preconditioner;
+    options.lbfgs_history = history;
     const mess::MinimiserResult r = mess::minimise(sys, options);
     EXPECT_TRUE(r.converged) << mess::to_string(r.status);
     return std::pair{Eigen::Matrix3Xd(sys.positions() / l.element_length), r.iterations};
@@ -387,6 +393,16 @@ TEST(MultilevelCorrection, MinimiserReachesTheSameStateWithIt) {
   EXPECT_EQ(automatic, without);
   EXPECT_EQ(automatic_iterations, without_iterations);
   EXPECT_GT(with_iterations, 0);
+  using mess::LbfgsHistoryPrecision;
+  const auto [with_double, with_double_iterations] =
+      relax(mess::LbfgsPreconditioner::multilevel, LbfgsHistoryPrecision::double_precision);
+  EXPECT_LT((with_double - without).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_NE(with_double, with);  // the single-precision pairs took another path
+  const auto [without_single, without_single_iterations] =
+      relax(mess::LbfgsPreconditioner::rigid_particles, LbfgsHistoryPrecision::single_precision);
+  EXPECT_LT((without_single - without).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_NE(without_single, without);
+  EXPECT_GT(with_double_iterations + without_single_iterations, 0);
 }
 
 // Where the lattice is large the polymer's long waves dominate, and the correction takes

@@ -313,11 +313,12 @@ class Minimisation {
         alternating_(alternating),
         budget_(options.max_iterations),
         method_(options.method) {
+    bool multilevel = false;
     if (options.precondition && options.method != MinimiserMethod::fire &&
         options.lbfgs_preconditioner != LbfgsPreconditioner::multigrid) {
-      const bool multilevel = options.lbfgs_preconditioner == LbfgsPreconditioner::multilevel ||
-                              (options.lbfgs_preconditioner == LbfgsPreconditioner::automatic &&
-                               system.node_count() >= kMultilevelMinimumNodes);
+      multilevel = options.lbfgs_preconditioner == LbfgsPreconditioner::multilevel ||
+                   (options.lbfgs_preconditioner == LbfgsPreconditioner::automatic &&
+                    system.node_count() >= kMultilevelMinimumNodes);
       preconditioner_ =
           options.preconditioner_cache != nullptr
               ? options.preconditioner_cache->get(system, map, force_scale, multilevel)
@@ -325,6 +326,10 @@ class Minimisation {
                     system, map, force_scale, multilevel,
                     multilevel ? &system.positions() : nullptr);  // as the cache builds it
     }
+    const bool single = options.lbfgs_history == LbfgsHistoryPrecision::single_precision ||
+                        (options.lbfgs_history == LbfgsHistoryPrecision::automatic && multilevel);
+    lbfgs_memory_.set_precision(single ? detail::LbfgsPrecision::single_precision
+                                       : detail::LbfgsPrecision::double_precision);
     // Over MPI processes each keeps only its blocks of the L-BFGS pairs (docs/mpi.md).
     if (options.distributed != nullptr) {
       lbfgs_memory_.set_split(options.distributed->vector_split());

@@ -84,6 +84,15 @@ enum class LbfgsPreconditioner { automatic, multilevel, rigid_particles, multigr
 // of the same pair at five lattice sizes: multilevel/rigid_particles wall time 1.4x at 14,400
 // nodes, 1.06x at 26,496 and 0.75x at 48,600 (docs/performance.md).
 inline constexpr std::int64_t kMultilevelMinimumNodes = 40000;
+// How L-BFGS stores its pairs (lbfgs_memory.hpp):
+//  automatic (the default): single precision where the preconditioner is the multilevel one
+//    (so run files' method = "minimiser" from kMultilevelMinimumNodes nodes on), else double;
+//  double_precision, single_precision.
+// In single precision the ten pairs take 240 instead of 480 bytes per node, the largest part
+// of a relaxation's memory, and the recursion sweeps half the bytes; the product is the L-BFGS
+// operator of the rounded pairs (still symmetric positive definite). Measured in
+// docs/performance.md ("The L-BFGS pairs in single precision").
+enum class LbfgsHistoryPrecision { automatic, double_precision, single_precision };
 enum class MagnetizationCoupling { alternating, every_evaluation };
 // stalled: 50 L-BFGS iterations without a new smallest force or an energy decrease beyond
 // rounding (the tolerance is below what the configuration's rounding allows).
@@ -136,6 +145,7 @@ struct MinimiserOptions {
   // L-BFGS only: initial inverse Hessian from `lbfgs_preconditioner` (false: the identity).
   bool precondition = true;
   LbfgsPreconditioner lbfgs_preconditioner = LbfgsPreconditioner::automatic;
+  LbfgsHistoryPrecision lbfgs_history = LbfgsHistoryPrecision::automatic;
   // multilevel and rigid_particles: where the preconditioner is kept between calls (a caller
   // relaxing many steps of one system keeps one; null: built anew in every call).
   std::shared_ptr<PreconditionerCache> preconditioner_cache;
