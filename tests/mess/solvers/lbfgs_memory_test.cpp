@@ -80,6 +80,25 @@ struct Fixture {
   int applications = 0;
 };
 
+// The memory's product with g on 1, 2, 3 and 8 threads: `expected` to 1e-12, and bitwise the
+// same on each.
+void expect_product_on_every_thread_count(Fixture& f, const Eigen::VectorXd& g,
+                                          const Eigen::VectorXd& expected) {
+  const int threads_before = omp_get_max_threads();
+  Eigen::VectorXd first;
+  for (const int threads : {1, 2, 3, 8}) {
+    omp_set_num_threads(threads);
+    const Eigen::VectorXd product = f.memory.times(g, f.preconditioner);
+    EXPECT_LE((product - expected).norm(), 1e-12 * expected.norm()) << g.size() << " " << threads;
+    if (threads == 1) {
+      first = product;
+    } else {
+      EXPECT_TRUE(product == first) << "not bitwise the same with " << threads << " threads";
+    }
+  }
+  omp_set_num_threads(threads_before);
+}
+
 TEST(LbfgsMemory, TwoLoopAgreesWithTheSerialRecursionOnEveryThreadCount) {
   // Below one summation block, across the parallel threshold with a partial last block.
   for (const Eigen::Index n : {Eigen::Index{50}, kParallelMinimum + 4097}) {
@@ -87,19 +106,7 @@ TEST(LbfgsMemory, TwoLoopAgreesWithTheSerialRecursionOnEveryThreadCount) {
     ASSERT_EQ(f.memory.size(), 10);
     const Eigen::VectorXd g = random_vector(n, f.random);
     const Eigen::VectorXd expected = serial_two_loop(f.pairs, g, f.p_diagonal);
-    const int threads_before = omp_get_max_threads();
-    Eigen::VectorXd first;
-    for (const int threads : {1, 2, 3, 8}) {
-      omp_set_num_threads(threads);
-      const Eigen::VectorXd product = f.memory.times(g, f.preconditioner);
-      EXPECT_LE((product - expected).norm(), 1e-12 * expected.norm()) << n << " " << threads;
-      if (threads == 1) {
-        first = product;
-      } else {
-        EXPECT_TRUE(product == first) << "not bitwise the same with " << threads << " threads";
-      }
-    }
-    omp_set_num_threads(threads_before);
+    expect_product_on_every_thread_count(f, g, expected);
   }
 }
 
@@ -124,19 +131,7 @@ TEST(LbfgsMemory, SinglePrecisionIsTheRecursionOfTheRoundedPairs) {
     // The rounding is visible, and small.
     EXPECT_GT((expected - unrounded).norm(), 1e-12 * unrounded.norm());
     EXPECT_LE((expected - unrounded).norm(), 1e-5 * unrounded.norm());
-    const int threads_before = omp_get_max_threads();
-    Eigen::VectorXd first;
-    for (const int threads : {1, 2, 3, 8}) {
-      omp_set_num_threads(threads);
-      const Eigen::VectorXd product = f.memory.times(g, f.preconditioner);
-      EXPECT_LE((product - expected).norm(), 1e-12 * expected.norm()) << n << " " << threads;
-      if (threads == 1) {
-        first = product;
-      } else {
-        EXPECT_TRUE(product == first) << "not bitwise the same with " << threads << " threads";
-      }
-    }
-    omp_set_num_threads(threads_before);
+    expect_product_on_every_thread_count(f, g, expected);
     // A new precision clears the memory.
     f.memory.set_precision(LbfgsPrecision::double_precision);
     EXPECT_TRUE(f.memory.empty());

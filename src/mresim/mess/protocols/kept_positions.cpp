@@ -19,6 +19,26 @@ std::runtime_error spill_error(const std::filesystem::path& directory, const std
                             what + ": " + std::strerror(error));
 }
 
+// Moves the `bytes` bytes of record `record` by io(offset in the record, count) (a pread or
+// pwrite, which may move fewer), retrying on EINTR. Throws naming the directory, the operation and
+// the reason (a full disk shows as "No space left on device").
+template <class Io>
+void transfer(const std::filesystem::path& directory, const char* what, std::int64_t record,
+              std::int64_t bytes, Io&& io) {
+  std::int64_t done = 0;
+  while (done < bytes) {
+    const ssize_t n = io(done, bytes - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      throw spill_error(directory,
+                        std::string("cannot ") + what + " record " + std::to_string(record) + " (" +
+                            std::to_string(bytes) + " bytes)",
+                        n < 0 ? errno : ENOSPC);
+    }
+    done += n;
+  }
+}
+
 }  // namespace
 
 PositionsSpill::PositionsSpill(const std::filesystem::path& directory, Eigen::Index columns)
@@ -50,38 +70,25 @@ std::int64_t PositionsSpill::write(const Eigen::Matrix3Xd& x) {
   } else {
     ++records_;
   }
-  const auto* bytes = reinterpret_cast<const char*>(x.data());
-  const std::int64_t total = record_bytes();
-  std::int64_t done = 0;
-  while (done < total) {
-    const ssize_t n = ::pwrite(fd_, bytes + done, static_cast<std::size_t>(total - done),
-                               static_cast<off_t>(record * total + done));
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int error = n < 0 ? errno : ENOSPC;
-      free_.push_back(record);
-      throw spill_error(directory_, "cannot write " + std::to_string(total) + " bytes", error);
-    }
-    done += n;
+  try {
+    transfer(directory_, "write", record, record_bytes(), [&](std::int64_t at, std::int64_t n) {
+      return ::pwrite(fd_, reinterpret_cast<const char*>(x.data()) + at,
+                      static_cast<std::size_t>(n),
+                      static_cast<off_t>(record * record_bytes() + at));
+    });
+  } catch (...) {
+    free_.push_back(record);
+    throw;
   }
   return record;
 }
 
 Eigen::Matrix3Xd PositionsSpill::read(std::int64_t record) const {
   Eigen::Matrix3Xd x(3, columns_);
-  auto* bytes = reinterpret_cast<char*>(x.data());
-  const std::int64_t total = record_bytes();
-  std::int64_t done = 0;
-  while (done < total) {
-    const ssize_t n = ::pread(fd_, bytes + done, static_cast<std::size_t>(total - done),
-                              static_cast<off_t>(record * total + done));
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      throw spill_error(directory_, "cannot read record " + std::to_string(record),
-                        n < 0 ? errno : EIO);
-    }
-    done += n;
-  }
+  transfer(directory_, "read", record, record_bytes(), [&](std::int64_t at, std::int64_t n) {
+    return ::pread(fd_, reinterpret_cast<char*>(x.data()) + at, static_cast<std::size_t>(n),
+                   static_cast<off_t>(record * record_bytes() + at));
+  });
   return x;
 }
 
