@@ -42,7 +42,10 @@ LbfgsMemory::Preconditioner mixing_preconditioner(const Eigen::VectorXd& w) {
 
 }  // namespace
 
-TEST(DistributedLbfgsMemory, TwoLoopProductIsBitwiseTheSingleProcessOne) {
+// With the pairs stored in `precision`.
+void expect_split_product_is_the_whole_one(mess::detail::LbfgsPrecision precision) {
+  SCOPED_TRACE(precision == mess::detail::LbfgsPrecision::single_precision ? "single precision"
+                                                                           : "double precision");
   const Eigen::Index n = 3 * kSumBlock + 1234;  // four blocks, the last one short
   std::mt19937_64 rng(7);
   const Eigen::VectorXd curvature = 1.0 + random_vector(n, rng).array().abs();
@@ -51,6 +54,8 @@ TEST(DistributedLbfgsMemory, TwoLoopProductIsBitwiseTheSingleProcessOne) {
 
   LbfgsMemory whole;
   LbfgsMemory split;
+  whole.set_precision(precision);
+  split.set_precision(precision);
   split.set_split(std::make_shared<mess::MpiBlockSplit>(MPI_COMM_WORLD));
   constexpr int kCapacity = 3;
   Eigen::VectorXd g_old = random_vector(n, rng);
@@ -87,6 +92,11 @@ TEST(DistributedLbfgsMemory, TwoLoopProductIsBitwiseTheSingleProcessOne) {
   if (world_size() > 1) {
     EXPECT_TRUE(everywhere(mine <= 2 * kCapacity * 2 * kSumBlock)) << mine;
   }
+}
+
+TEST(DistributedLbfgsMemory, TwoLoopProductIsBitwiseTheSingleProcessOne) {
+  expect_split_product_is_the_whole_one(mess::detail::LbfgsPrecision::double_precision);
+  expect_split_product_is_the_whole_one(mess::detail::LbfgsPrecision::single_precision);
 }
 
 TEST(DistributedLbfgsMemory, BlocksAreDealtOutWholeAndInOrder) {
