@@ -176,6 +176,37 @@ void print_loop(int order, const char* method, const Outcome& o) {
   std::fflush(stdout);
 }
 
+struct LbfgsWalls {
+  double lbfgs = 0.0;
+  double minimiser = 0.0;
+};
+
+// The L-BFGS variants at one order, each printed with its ratio to its reference (newton's
+// outcome n for lbfgs): lbfgs, minimiser, minimiser-d and, for the seed profile, lbfgs-exact.
+LbfgsWalls relax_lbfgs_variants(const mess::ModelProfile& profile, const std::string& profile_name,
+                                int order, std::int64_t nodes, const Outcome& n) {
+  const Outcome l = relax(profile, order, mess::MinimiserMethod::lbfgs);
+  print(order, nodes, "lbfgs", l);
+  print_against("lbfgs", l, "newton", n);
+  const Outcome ml =
+      relax(profile, order, mess::MinimiserMethod::lbfgs, mess::LbfgsPreconditioner::multilevel);
+  print(order, nodes, "minimiser", ml);
+  print_against("minimiser", ml, "lbfgs", l);
+  // The same with the pairs in double precision (the minimiser's own are single).
+  const Outcome md = relax(
+      profile, order, mess::MinimiserMethod::lbfgs, mess::LbfgsPreconditioner::multilevel,
+      mess::MinimiserOptions{}.correction_forcing, mess::LbfgsHistoryPrecision::double_precision);
+  print(order, nodes, "minimiser-d", md);
+  print_against("minimiser", ml, "minimiser-d", md);
+  if (profile_name == "seed") {  // only the seed profile has correction passes
+    const Outcome e = relax(profile, order, mess::MinimiserMethod::lbfgs,
+                            mess::LbfgsPreconditioner::rigid_particles, 0.0);
+    print(order, nodes, "lbfgs-exact", e);
+    print_against("lbfgs-exact", e, "lbfgs", l);
+  }
+  return {l.wall, ml.wall};
+}
+
 // Least-squares slope of log t against log N.
 double exponent(const std::vector<double>& nodes, const std::vector<double>& seconds) {
   double sx = 0.0;
@@ -245,27 +276,10 @@ int main(int argc, char** argv) {
     const Outcome n = relax(profile, order, mess::MinimiserMethod::newton);
     print(order, nodes, "newton", n);
     if (order <= lbfgs_max_order) {
-      const Outcome l = relax(profile, order, mess::MinimiserMethod::lbfgs);
-      print(order, nodes, "lbfgs", l);
-      print_against("lbfgs", l, "newton", n);
-      if (order >= 2) lbfgs_fit.push_back(l.wall);
-      const Outcome ml = relax(profile, order, mess::MinimiserMethod::lbfgs,
-                               mess::LbfgsPreconditioner::multilevel);
-      print(order, nodes, "minimiser", ml);
-      print_against("minimiser", ml, "lbfgs", l);
-      if (order >= 2) minimiser_fit.push_back(ml.wall);
-      // The same with the pairs in double precision (the minimiser's own are single).
-      const Outcome md =
-          relax(profile, order, mess::MinimiserMethod::lbfgs, mess::LbfgsPreconditioner::multilevel,
-                mess::MinimiserOptions{}.correction_forcing,
-                mess::LbfgsHistoryPrecision::double_precision);
-      print(order, nodes, "minimiser-d", md);
-      print_against("minimiser", ml, "minimiser-d", md);
-      if (profile_name == "seed") {  // only the seed profile has correction passes
-        const Outcome e = relax(profile, order, mess::MinimiserMethod::lbfgs,
-                                mess::LbfgsPreconditioner::rigid_particles, 0.0);
-        print(order, nodes, "lbfgs-exact", e);
-        print_against("lbfgs-exact", e, "lbfgs", l);
+      const LbfgsWalls walls = relax_lbfgs_variants(profile, profile_name, order, nodes, n);
+      if (order >= 2) {
+        lbfgs_fit.push_back(walls.lbfgs);
+        minimiser_fit.push_back(walls.minimiser);
       }
     }
     if (order <= multigrid_lbfgs_max_order) {

@@ -106,6 +106,28 @@ mess::MinimiserOptions ProtocolRunner::minimiser_options() const {
   return options;
 }
 
+void ProtocolRunner::set_start(const StepSpec& step, ProtocolState& state) {
+  const SlotState* start = start_state(step, state);
+  SlotState& slot = state.slots[slot_of_field(step.field_index)];
+  if (start == &slot && slot.positions.cols() > 0) {
+    // The step replaces the state it starts from (a field loop's one slot; a load step's own):
+    // the system takes the positions over instead of copying them, 24 bytes per node less
+    // while it relaxes. The slot is written again after the step; if the step throws, the run
+    // ends and resumes from its last checkpoint.
+    system_.set_positions(slot.positions.take());
+  } else {
+    system_.set_positions(start != nullptr && start->positions.cols() > 0
+                              ? start->positions.load()
+                              : system_.lattice().positions);
+  }
+  // The system holds the start now: every kept array can wait in the scratch file while the
+  // step relaxes (the step's own slot and reference are written again after it).
+  park_kept_positions(state);
+  if (start != nullptr && start->magnetization.cols() > 0) {
+    system_.set_magnetizations(start->magnetization);
+  }
+}
+
 const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   if (state.next_step >= steps_.size()) {
     throw std::logic_error("ProtocolRunner::run_next_step: no steps left");
@@ -123,26 +145,10 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   const auto reference_of_field = [&] { return state.references[step.field_index].load(); };
   LoadState load = protocol.load(lat, step, loaded ? reference_of_field() : lat.positions);
 
-  const SlotState* start = start_state(step, state);
   SlotState& slot = state.slots[slot_of_field(step.field_index)];
   system_.set_constraints(std::move(load.constraints));
   system_.set_applied_forces(load.applied_forces);
-  if (start == &slot && slot.positions.cols() > 0) {
-    // The step replaces the state it starts from (a field loop's one slot; a load step's own):
-    // the system takes the positions over instead of copying them, 24 bytes per node less
-    // while it relaxes. The slot is written again below; if the step throws, the run ends and
-    // resumes from its last checkpoint.
-    system_.set_positions(slot.positions.take());
-  } else {
-    system_.set_positions(start != nullptr && start->positions.cols() > 0 ? start->positions.load()
-                                                                          : lat.positions);
-  }
-  // The system holds the start now: every kept array can wait in the scratch file while the
-  // step relaxes (the step's own slot and reference are written again below).
-  park_kept_positions(state);
-  if (start != nullptr && start->magnetization.cols() > 0) {
-    system_.set_magnetizations(start->magnetization);
-  }
+  set_start(step, state);
   system_.set_applied_field(step.field / kMu0);
 
   const mess::MagnetizationStats before = system_.magnetization_stats();

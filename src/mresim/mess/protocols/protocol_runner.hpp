@@ -138,6 +138,9 @@ class ProtocolRunner {
  private:
   std::size_t slot_of_field(std::size_t field_index) const;
   const SlotState* start_state(const StepSpec& step, const ProtocolState& state) const;
+  // Puts the step's start (start_state: positions and magnetizations; the initial lattice
+  // without one) into the system, then parks the kept positions.
+  void set_start(const StepSpec& step, ProtocolState& state);
   // The run file's solver settings for one relaxation, with the run's caches.
   mess::MinimiserOptions minimiser_options() const;
 
