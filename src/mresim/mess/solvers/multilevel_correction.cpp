@@ -5,6 +5,7 @@
 #include <exception>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "mresim/mess/solvers/stiffness_terms.hpp"
 
@@ -16,106 +17,96 @@ namespace {
 // lattice numbers its nodes (lattice/grid.hpp). dims = {nx, ny, nz}.
 using Dims = std::array<int, 3>;
 
-std::array<std::int64_t, 3> strides(const Dims& d) {
-  return {static_cast<std::int64_t>(d[2]), static_cast<std::int64_t>(d[2]) * d[0], 1};
-}
-
 std::int64_t point_count(const Dims& d) { return static_cast<std::int64_t>(d[0]) * d[1] * d[2]; }
 
-// Calls line(in_offset, out_offset) for every grid line along `axis`, in parallel: each line is
-// one thread's, so what a line computes does not depend on the number of threads.
-template <class Line>
-void for_each_line(const Dims& in, const Dims& out, int axis, Line&& line) {
-  const int b = axis == 0 ? 1 : 0;
-  const int c = axis == 2 ? 1 : 2;
-  const auto si = strides(in);
-  const auto so = strides(out);
-  const std::int64_t lines =
-      static_cast<std::int64_t>(in[static_cast<std::size_t>(b)]) * in[static_cast<std::size_t>(c)];
-#pragma omp parallel for schedule(static) if (lines * in[static_cast <std::size_t>(axis)] > 20000)
-  for (std::int64_t l = 0; l < lines; ++l) {
-    const std::int64_t ib = l / in[static_cast<std::size_t>(c)];
-    const std::int64_t ic = l % in[static_cast<std::size_t>(c)];
-    line(3 * (ib * si[static_cast<std::size_t>(b)] + ic * si[static_cast<std::size_t>(c)]),
-         3 * (ib * so[static_cast<std::size_t>(b)] + ic * so[static_cast<std::size_t>(c)]));
+// A grid field of 3-vectors seen along one axis: `outer` blocks, each of the axis's points in
+// turn, each point a slice of `inner` contiguous values (the node numbering iz + nz (ix + nx iy)
+// makes z the fastest axis, then x, then y). Along z a slice is one node's 3 values; along x it
+// is a whole z-line of the grid (3 nz values), along y a whole y-plane (3 nz nx).
+struct AxisView {
+  std::int64_t outer = 0;
+  std::int64_t inner = 0;
+};
+
+AxisView view_along(const Dims& d, int axis) {
+  if (axis == 2) return {static_cast<std::int64_t>(d[0]) * d[1], 3};
+  if (axis == 0) return {d[1], 3 * static_cast<std::int64_t>(d[2])};
+  return {1, 3 * static_cast<std::int64_t>(d[2]) * d[0]};
+}
+
+// Runs slice(o, j) for the slices j < points of every block o < outer of an output whose
+// slices hold `inner` values, in parallel when there is enough work; each slice is one
+// thread's, so what it computes does not depend on the number of threads.
+template <class Slice>
+void for_each_slice(std::int64_t outer, int points, std::int64_t inner, Slice&& slice) {
+#pragma omp parallel for collapse(2) schedule(static) if (outer * points * inner > 60000)
+  for (std::int64_t o = 0; o < outer; ++o) {
+    for (int j = 0; j < points; ++j) slice(o, j);
   }
 }
 
 // Restricts a field of 3-vectors on the grid `dims` along `axis` to `level`'s points there:
-// out[j] = sum_i phi_j(i) in[i] over each grid line, in index order. read(c) gives the input at
-// flat index c = 3 node + component.
-template <class Level, class Read>
-void restrict_axis(Read&& read, const Dims& dims, int axis, const Level& level,
+// out[j] = sum_i phi_j(i) in[i] over each grid line, the terms in increasing i (Axis::term_begin).
+// Whole slices at a time, so the inner loops run over contiguous values. read(c) gives the
+// input at flat index c = 3 node + component.
+template <class Axis, class Read>
+void restrict_axis(Read&& read, const Dims& dims, int axis, const Axis& ax, int n_out,
                    Eigen::VectorXd& out) {
-  const auto& ax = level.axes[static_cast<std::size_t>(axis)];
-  Dims next = dims;
-  next[static_cast<std::size_t>(axis)] = level.points[static_cast<std::size_t>(axis)];
-  out.resize(3 * point_count(next));
-  const std::int64_t si = 3 * strides(dims)[static_cast<std::size_t>(axis)];
-  const std::int64_t so = 3 * strides(next)[static_cast<std::size_t>(axis)];
-  const int n_in = dims[static_cast<std::size_t>(axis)];
-  const int n_out = next[static_cast<std::size_t>(axis)];
-  for_each_line(dims, next, axis, [&](std::int64_t in_offset, std::int64_t out_offset) {
-    for (int j = 0; j < n_out; ++j) {
-      for (int a = 0; a < 3; ++a) out[out_offset + j * so + a] = 0.0;
-    }
-    for (int i = 0; i < n_in; ++i) {
-      const double t = ax.upper[static_cast<std::size_t>(i)];
-      const std::int64_t lo = out_offset + ax.lower[static_cast<std::size_t>(i)] * so;
-      for (int a = 0; a < 3; ++a) {
-        const double value = read(in_offset + i * si + a);
-        out[lo + a] += (1.0 - t) * value;
-        if (t != 0.0) out[lo + so + a] += t * value;
+  const AxisView view = view_along(dims, axis);
+  const std::int64_t n_in = dims[static_cast<std::size_t>(axis)];
+  out.resize(view.outer * n_out * view.inner);
+  double* const result = out.data();
+  for_each_slice(view.outer, n_out, view.inner, [&](std::int64_t o, int point) {
+    const auto j = static_cast<std::size_t>(point);
+    double* const dst = result + (o * n_out + point) * view.inner;
+    const int first = ax.term_begin[j];
+    const int last = ax.term_begin[j + 1];
+    // Each value's sum in a register, its terms in increasing i (starting from 0.0, as a sweep
+    // that adds into a zeroed array would): the values of a slice are independent sums.
+    for (std::int64_t e = 0; e < view.inner; ++e) {
+      double sum = 0.0;
+      for (int t = first; t < last; ++t) {
+        const auto term = static_cast<std::size_t>(t);
+        sum += ax.term_weight[term] * read((o * n_in + ax.term_fine[term]) * view.inner + e);
       }
+      dst[e] = sum;
     }
   });
 }
 
 // The transpose: interpolates `in` (on `coarse` dims, `level`'s points along `axis`) to the
-// finer grid `fine` along `axis`; write(c, value) takes each fine value once.
-template <class Level, class Write>
-void interpolate_axis(const Eigen::VectorXd& in, const Dims& coarse, int axis, const Level& level,
-                      const Dims& fine, Write&& write) {
-  const auto& ax = level.axes[static_cast<std::size_t>(axis)];
-  const std::int64_t si = 3 * strides(coarse)[static_cast<std::size_t>(axis)];
-  const std::int64_t so = 3 * strides(fine)[static_cast<std::size_t>(axis)];
-  const int n_out = fine[static_cast<std::size_t>(axis)];
-  for_each_line(fine, coarse, axis, [&](std::int64_t out_offset, std::int64_t in_offset) {
-    for (int i = 0; i < n_out; ++i) {
-      const double t = ax.upper[static_cast<std::size_t>(i)];
-      const std::int64_t lo = in_offset + ax.lower[static_cast<std::size_t>(i)] * si;
-      for (int a = 0; a < 3; ++a) {
-        write(out_offset + i * so + a,
-              t == 0.0 ? in[lo + a] : (1.0 - t) * in[lo + a] + t * in[lo + si + a]);
-      }
+// `n_fine` points of the finer grid along `axis`; write(c, value) takes each fine value once,
+// c the flat index on the finer grid.
+template <class Axis, class Write>
+void interpolate_axis(const Eigen::VectorXd& in, const Dims& coarse, int axis, const Axis& ax,
+                      int n_fine, Write&& write) {
+  const AxisView view = view_along(coarse, axis);
+  const std::int64_t n_coarse = coarse[static_cast<std::size_t>(axis)];
+  const double* const source = in.data();
+  for_each_slice(view.outer, n_fine, view.inner, [&](std::int64_t o, int point) {
+    const auto i = static_cast<std::size_t>(point);
+    const double t = ax.upper[i];
+    const double* const a = source + (o * n_coarse + ax.lower[i]) * view.inner;
+    const double* const b = a + view.inner;
+    const std::int64_t base = (o * n_fine + point) * view.inner;
+    if (t == 0.0) {
+      for (std::int64_t e = 0; e < view.inner; ++e) write(base + e, a[e]);
+    } else {
+      for (std::int64_t e = 0; e < view.inner; ++e) write(base + e, (1.0 - t) * a[e] + t * b[e]);
     }
   });
 }
 
 auto vector_reader(const Eigen::VectorXd& v) {
-  return [&v](std::int64_t c) { return v[c]; };
+  const double* const data = v.data();
+  return [data](std::int64_t c) { return data[c]; };
 }
 
 // Writes into `v`, sized for the grid `dims`.
 auto vector_writer(Eigen::VectorXd& v, const Dims& dims) {
   v.resize(3 * point_count(dims));
-  return [&v](std::int64_t c, double value) { v[c] = value; };
-}
-
-// One rank-one term's projection onto a level: per level node, the three axes' values.
-struct Entry {
-  std::int64_t node;
-  std::array<double, 3> value;
-};
-
-void add_entry(std::vector<Entry>& z, std::int64_t node, const std::array<double, 3>& value) {
-  for (Entry& e : z) {
-    if (e.node == node) {
-      for (std::size_t a = 0; a < 3; ++a) e.value[a] += value[a];
-      return;
-    }
-  }
-  z.push_back({node, value});
+  double* const data = v.data();
+  return [data](std::int64_t c, double value) { data[c] = value; };
 }
 
 constexpr int kReach = 2;  // the coarsest level's couplings reach 2 points along each axis
@@ -143,6 +134,26 @@ Eigen::Index MultilevelCorrection::level_size(int level) const {
   return 3 * point_count(l.points);
 }
 
+void MultilevelCorrection::add_restriction_terms(Axis& axis, int points) {
+  // Point i of the finer grid gives (1 - t_i) to its lower bracket and t_i to the upper one
+  // (when t_i != 0); each coarse point takes its terms in increasing i.
+  std::vector<std::vector<std::pair<int, double>>> terms(static_cast<std::size_t>(points));
+  for (std::size_t i = 0; i < axis.lower.size(); ++i) {
+    const auto lower = static_cast<std::size_t>(axis.lower[i]);
+    const double t = axis.upper[i];
+    terms[lower].emplace_back(static_cast<int>(i), 1.0 - t);
+    if (t != 0.0) terms[lower + 1].emplace_back(static_cast<int>(i), t);
+  }
+  axis.term_begin.assign(1, 0);
+  for (const auto& point : terms) {
+    for (const auto& [fine, weight] : point) {
+      axis.term_fine.push_back(fine);
+      axis.term_weight.push_back(weight);
+    }
+    axis.term_begin.push_back(static_cast<int>(axis.term_fine.size()));
+  }
+}
+
 void MultilevelCorrection::build_levels(Eigen::Index exact_limit) {
   std::array<std::vector<int>, 3> planes;
   for (std::size_t a = 0; a < 3; ++a) {
@@ -166,6 +177,7 @@ void MultilevelCorrection::build_levels(Eigen::Index exact_limit) {
         axis.lower.push_back(lower);
         axis.upper.push_back((finer[i] - p0) / (p1 - p0));
       }
+      add_restriction_terms(axis, m);
       level.points[a] = m;
     }
     // A grid of two planes per axis cannot be coarsened: the previous level is the coarsest.
@@ -182,8 +194,8 @@ void MultilevelCorrection::build_levels(Eigen::Index exact_limit) {
 namespace {
 
 // Sums the rank-one terms c z z^T of the reference Hessian projected onto one level: the
-// diagonal always, the 3 x 3 blocks of each point's neighbours (<= kReach apart) when the
-// level is solved exactly.
+// diagonal always, and when the level is solved exactly the 3 x 3 blocks of each point with its
+// neighbours (<= kReach apart) that its sparse factor reads (the lower triangle).
 class LevelAssembler {
  public:
   LevelAssembler(const std::array<std::vector<int>, 3>& planes, const Dims& fine,
@@ -205,61 +217,99 @@ class LevelAssembler {
     if (exact) blocks_.assign(static_cast<std::size_t>(count * kNeighbours * 9), 0.0);
   }
 
-  void clear() { z_.clear(); }
+  // Starts a term over the lattice nodes `nodes` (then add_node(k, ...) for each k-th of them):
+  // its projection lives on the level points that bracket them, a patch of at most 3 along each
+  // axis (springs and cells join lattice points at most one plane apart, and each coarser
+  // plane's bracket moves by at most one point from one lattice plane to the next).
+  template <std::size_t Count>
+  void start(const std::array<std::int64_t, Count>& nodes) {
+    for (const int p : touched_) is_touched_[static_cast<std::size_t>(p)] = false;
+    touched_.clear();
+    base_ = {points_[0], points_[1], points_[2]};
+    const auto nz = static_cast<std::int32_t>(fine_[2]);
+    const auto nx = static_cast<std::int32_t>(fine_[0]);
+    for (std::size_t k = 0; k < Count; ++k) {
+      const auto n = static_cast<std::int32_t>(nodes[k]);  // DofMap: 3 N fits 32 bits
+      const std::int32_t line = n / nz;
+      node_[k] = {line % nx, line / nx, n % nz};
+      for (std::size_t a = 0; a < 3; ++a) {
+        base_[a] = std::min(base_[a], lower_[a][static_cast<std::size_t>(node_[k][a])]);
+        free_[k][a] = map_.own_dof_of_coordinate(3 * nodes[k] + static_cast<std::int64_t>(a)) >= 0;
+      }
+    }
+  }
 
-  // z += sign direction_a phi_n for the free coordinates a of lattice node n.
-  void add_node(std::int64_t n, const Eigen::Vector3d& direction, double sign) {
-    const auto nz = static_cast<std::int64_t>(fine_[2]);
-    const auto nx = static_cast<std::int64_t>(fine_[0]);
-    const std::array<std::int64_t, 3> i{(n / nz) % nx, n / nz / nx, n % nz};
+  // z += sign direction_a phi_n for the free coordinates a of the k-th node n of start(). A
+  // point's value is the sum of its nodes' parts in the order they come (as a list of entries
+  // merged by point would give it).
+  void add_node(std::size_t k, const Eigen::Vector3d& direction, double sign) {
+    const std::array<int, 3>& i = node_[k];
     for (int c = 0; c < 8; ++c) {
-      std::array<std::int64_t, 3> j{};
+      std::array<int, 3> offset{};
       double w = sign;
       for (std::size_t a = 0; a < 3; ++a) {
         const bool up = ((c >> a) & 1) != 0;
         const auto f = static_cast<std::size_t>(i[a]);
-        j[a] = lower_[a][f] + (up ? 1 : 0);
+        offset[a] = lower_[a][f] + (up ? 1 : 0) - base_[a];
         w *= up ? upper_[a][f] : 1.0 - upper_[a][f];
       }
       if (w == 0.0) continue;
-      const std::int64_t node =
-          j[2] + points_[2] * (j[0] + static_cast<std::int64_t>(points_[0]) * j[1]);
+      if (offset[0] > 2 || offset[1] > 2 || offset[2] > 2) {
+        throw std::logic_error("MultilevelCorrection: a term reaches beyond its 3 x 3 x 3 patch");
+      }
       std::array<double, 3> value{};
       for (std::size_t a = 0; a < 3; ++a) {
-        if (map_.own_dof_of_coordinate(3 * n + static_cast<std::int64_t>(a)) >= 0) {
-          value[a] = w * direction[static_cast<Eigen::Index>(a)];
-        }
+        if (free_[k][a]) value[a] = w * direction[static_cast<Eigen::Index>(a)];
       }
-      add_entry(z_, node, value);
+      const int p = 9 * offset[0] + 3 * offset[1] + offset[2];
+      auto& point = patch_[static_cast<std::size_t>(p)];
+      if (!is_touched_[static_cast<std::size_t>(p)]) {
+        is_touched_[static_cast<std::size_t>(p)] = true;
+        touched_.push_back(p);
+        point = value;
+      } else {
+        for (std::size_t a = 0; a < 3; ++a) point[a] += value[a];
+      }
     }
   }
 
   // Adds c z z^T.
   void add_term(double c) {
-    for (const Entry& e : z_) {
+    for (const int p : touched_) {
+      const auto& e = patch_[static_cast<std::size_t>(p)];
+      const std::int64_t node = point_of(p);
       for (std::size_t a = 0; a < 3; ++a) {
-        diagonal_[static_cast<std::size_t>(3 * e.node) + a] += c * e.value[a] * e.value[a];
+        diagonal_[static_cast<std::size_t>(3 * node) + a] += c * e[a] * e[a];
       }
     }
     if (blocks_.empty()) return;
-    for (const Entry& e : z_) {
-      const auto je = coordinates(e.node);
-      for (const Entry& f : z_) {
-        const auto jf = coordinates(f.node);
-        const std::int64_t code = (jf[0] - je[0] + kReach) * kWidth * kWidth +
-                                  (jf[1] - je[1] + kReach) * kWidth + (jf[2] - je[2] + kReach);
-        double* block = blocks_.data() + (e.node * kNeighbours + code) * 9;
+    // Only the blocks the factor reads: its sparse LDL^T takes the lower triangle, so point J
+    // needs the blocks of its neighbours K <= J (coordinates are numbered 3 J + a).
+    for (const int p : touched_) {
+      const auto& e = patch_[static_cast<std::size_t>(p)];
+      const std::int64_t node = point_of(p);
+      for (const int q : touched_) {
+        if (point_of(q) > node) continue;
+        const auto& f = patch_[static_cast<std::size_t>(q)];
+        // Patch offsets differ by at most 2 <= kReach along each axis.
+        const int code = (q / 9 - p / 9 + kReach) * kWidth * kWidth +
+                         ((q / 3) % 3 - (p / 3) % 3 + kReach) * kWidth + (q % 3 - p % 3 + kReach);
+        double* block = blocks_.data() + (node * kNeighbours + code) * 9;
         for (std::size_t a = 0; a < 3; ++a) {
-          for (std::size_t b = 0; b < 3; ++b) block[3 * a + b] += c * e.value[a] * f.value[b];
+          for (std::size_t b = 0; b < 3; ++b) block[3 * a + b] += c * e[a] * f[b];
         }
       }
     }
   }
 
-  std::array<std::int64_t, 3> coordinates(std::int64_t node) const {
-    return {(node / points_[2]) % points_[0], node / points_[2] / points_[0], node % points_[2]};
-  }
   const std::vector<double>& diagonal() const { return diagonal_; }
+  // Level point index of patch point p.
+  std::int64_t point_of(int p) const {
+    const std::int64_t jx = base_[0] + p / 9;
+    const std::int64_t jy = base_[1] + (p / 3) % 3;
+    const std::int64_t jz = base_[2] + p % 3;
+    return jz + points_[2] * (jx + static_cast<std::int64_t>(points_[0]) * jy);
+  }
   const std::vector<double>& blocks() const { return blocks_; }
 
  private:
@@ -268,7 +318,14 @@ class LevelAssembler {
   const DofMap& map_;
   std::array<std::vector<int>, 3> lower_;
   std::array<std::vector<double>, 3> upper_;
-  std::vector<Entry> z_;
+  // The current term: its nodes' grid coordinates and free coordinates, its patch's lowest
+  // point, and its values on the patch (point 9 dx + 3 dy + dz) with the points it touched.
+  std::array<std::array<int, 3>, 8> node_{};
+  std::array<std::array<bool, 3>, 8> free_{};
+  std::array<int, 3> base_{};
+  std::array<std::array<double, 3>, 27> patch_{};
+  std::array<bool, 27> is_touched_{};
+  std::vector<int> touched_;
   std::vector<double> diagonal_;
   std::vector<double> blocks_;
 };
@@ -281,14 +338,16 @@ void add_stiffness(const lattice::Lattice& lattice, const Eigen::Matrix3Xd* stat
   for_each_stiffness_term(
       lattice, state, map, volume_force_factor, scale,
       [&level](std::int64_t i, std::int64_t j, const Eigen::Vector3d& u, double c) {
-        level.clear();
-        level.add_node(j, u, 1.0);
-        level.add_node(i, u, -1.0);
+        level.start(std::array<std::int64_t, 2>{j, i});
+        level.add_node(0, u, 1.0);
+        level.add_node(1, u, -1.0);
         level.add_term(c);
       },
       [&level](const auto& element, const lattice::CellVertices& g, double c) {
-        level.clear();
-        for (std::size_t v = 0; v < 8; ++v) level.add_node(element[v], g[v], 1.0);
+        std::array<std::int64_t, 8> nodes{};
+        for (std::size_t v = 0; v < 8; ++v) nodes[v] = element[v];
+        level.start(nodes);
+        for (std::size_t v = 0; v < 8; ++v) level.add_node(v, g[v], 1.0);
         level.add_term(c);
       });
 }
@@ -299,11 +358,14 @@ void MultilevelCorrection::assemble(const lattice::Lattice& lattice, double volu
                                     double scale, const DofMap& map,
                                     const Eigen::Matrix3Xd* state) {
   // Each level sweeps all springs and cells, and the levels are independent: one thread per
-  // level, so that each level's sums come in the same order whatever the thread count.
+  // level, so that each level's sums come in the same order whatever the thread count. The
+  // coarsest level, which also sums its neighbour blocks, takes about as long as two others:
+  // it goes first, so that the other threads share the remaining levels meanwhile.
   std::exception_ptr failure;
   const auto count = static_cast<std::int64_t>(levels_.size());
 #pragma omp parallel for schedule(dynamic, 1) if (point_count(fine_) >= 20000)
-  for (std::int64_t li = 0; li < count; ++li) {
+  for (std::int64_t order = 0; order < count; ++order) {
+    const std::int64_t li = count - 1 - order;
     try {
       Level& level = levels_[static_cast<std::size_t>(li)];
       const bool exact = li + 1 == count;
@@ -353,6 +415,7 @@ void MultilevelCorrection::factor_coarsest(const std::array<int, 3>& p,
         if (row < 0) continue;
         for (std::int64_t b = 0; b < 3; ++b) {
           const Eigen::Index col = exact_index_[static_cast<std::size_t>(3 * f + b)];
+          if (col > row) continue;  // the factor reads the lower triangle only
           const double value =
               blocks[static_cast<std::size_t>((e * kNeighbours + code) * 9 + 3 * a + b)];
           if (col >= 0 && value != 0.0) triplets.emplace_back(row, col, value);
@@ -391,18 +454,20 @@ void MultilevelCorrection::add_to(const DofMap& map, const Eigen::VectorXd& v,
   Dims dims = fine_;
   for (std::size_t li = 0; li < levels_.size(); ++li) {
     const Level& level = levels_[li];
+    const auto& axes = level.axes;
+    const auto& points = level.points;
     Eigen::VectorXd along_z;
     if (li == 0) {
-      restrict_axis(read_lattice, dims, 2, level, along_z);
+      restrict_axis(read_lattice, dims, 2, axes[2], points[2], along_z);
     } else {
-      restrict_axis(vector_reader(residual[li - 1]), dims, 2, level, along_z);
+      restrict_axis(vector_reader(residual[li - 1]), dims, 2, axes[2], points[2], along_z);
     }
-    dims[2] = level.points[2];
+    dims[2] = points[2];
     Eigen::VectorXd along_x;
-    restrict_axis(vector_reader(along_z), dims, 0, level, along_x);
-    dims[0] = level.points[0];
-    restrict_axis(vector_reader(along_x), dims, 1, level, residual[li]);
-    dims[1] = level.points[1];
+    restrict_axis(vector_reader(along_z), dims, 0, axes[0], points[0], along_x);
+    dims[0] = points[0];
+    restrict_axis(vector_reader(along_x), dims, 1, axes[1], points[1], residual[li]);
+    dims[1] = points[1];
   }
 
   const std::size_t last = levels_.size() - 1;
@@ -425,21 +490,22 @@ void MultilevelCorrection::add_to(const DofMap& map, const Eigen::VectorXd& v,
     Dims d = level.points;
     Eigen::VectorXd along_y;
     d[1] = finer[1];
-    interpolate_axis(update[li], level.points, 1, level, d, vector_writer(along_y, d));
+    interpolate_axis(update[li], level.points, 1, level.axes[1], d[1], vector_writer(along_y, d));
     update[li] = Eigen::VectorXd();  // done with: its memory goes before the finer level's
     Eigen::VectorXd along_x;
     Dims dx = d;
     dx[0] = finer[0];
-    interpolate_axis(along_y, d, 0, level, dx, vector_writer(along_x, dx));
+    interpolate_axis(along_y, d, 0, level.axes[0], dx[0], vector_writer(along_x, dx));
     if (li > 0) {
       Eigen::VectorXd& next = update[li - 1];
-      interpolate_axis(along_x, dx, 2, level, finer, vector_writer(next, finer));
+      interpolate_axis(along_x, dx, 2, level.axes[2], finer[2], vector_writer(next, finer));
       next += levels_[li - 1].inverse_diagonal.cwiseProduct(residual[li - 1]);
     } else {
-      interpolate_axis(along_x, dx, 2, level, finer, [&](std::int64_t coordinate, double value) {
-        const Eigen::Index k = map.own_dof_of_coordinate(coordinate);
-        if (k >= 0) w[k] += value;
-      });
+      interpolate_axis(along_x, dx, 2, level.axes[2], finer[2],
+                       [&](std::int64_t coordinate, double value) {
+                         const Eigen::Index k = map.own_dof_of_coordinate(coordinate);
+                         if (k >= 0) w[k] += value;
+                       });
     }
   }
 }

@@ -25,16 +25,21 @@
 //
 // Cost. Applying C restricts v level by level (one sweep per axis, each halving the data; the
 // first reads v in place), scales, solves the coarsest level and interpolates back (the last
-// sweep adds into w): about a fifth of an energy evaluation at 285k nodes. The sweeps are split
-// over the threads by grid lines, so the result is bitwise the same for any number of threads.
-// Memory: the levels' inverse diagonals (about 3 bytes per node) and the coarsest level's
-// factor (about 23 bytes per node at 285k nodes); while C is applied, the sweeps' transient
-// arrays (18 bytes per node) and the levels' fields. The free coordinates are read through the
-// minimiser's DofMap, which add_to() is given, instead of a copy of its map. Building it sweeps
-// the lattice's springs and cells once per level (each a rank-one term: stiffness_terms.hpp),
-// one thread per level (under 3 s at 285k nodes on 2 threads). It depends on the lattice, the free
-// coordinates, the force scale and the state; a run builds one at each relaxation's starting
-// state (PreconditionerCache, preconditioner.hpp).
+// sweep adds into w): about 3.5 ms at 285k nodes on 2 threads, a sixth of an energy evaluation
+// (bench/preconditioner_bench.cpp). Each sweep works on whole slices of the grid (a node's
+// three values along z, a z-line along x, a y-plane along y), each coarse value summing its
+// terms in a register in the order of the finer line; the slices are split over the threads,
+// so the result is bitwise the same for any number of threads. Memory: the levels' inverse
+// diagonals (about 3 bytes per node) and the coarsest level's factor (about 23 bytes per node
+// at 285k nodes); while C is applied, the sweeps' transient arrays (18 bytes per node) and the
+// levels' fields. The free coordinates are read through the minimiser's DofMap, which add_to()
+// is given, instead of a copy of its map. Building it sweeps the lattice's springs and cells
+// once per level (each a rank-one term: stiffness_terms.hpp), projecting each term onto the
+// 3 x 3 x 3 level points around it, one thread per level, the coarsest (which also sums the
+// lower triangle of its neighbour blocks, all its sparse factor reads) first: about 1.5 s at
+// 285k nodes on 2 threads. It depends on the lattice, the free coordinates, the force scale and
+// the state; a run builds one at each relaxation's starting state (PreconditionerCache,
+// preconditioner.hpp).
 
 #include <Eigen/Core>
 #include <Eigen/SparseCholesky>
@@ -75,11 +80,16 @@ class MultilevelCorrection {
  private:
   // One axis of a level: the lattice plane of each point, and for each point of the next finer
   // level (the lattice for level 1) the lower of its two bracketing points here and the weight
-  // of the upper one.
+  // of the upper one. The restriction's terms by coarse point j: term_begin[j] ..
+  // term_begin[j + 1] index term_fine (the finer point) and term_weight, in increasing finer
+  // point, so that each coarse value adds its terms in the order of a sweep over the finer line.
   struct Axis {
     std::vector<int> plane;
     std::vector<int> lower;
     std::vector<double> upper;
+    std::vector<int> term_begin;
+    std::vector<int> term_fine;
+    std::vector<double> term_weight;
   };
   struct Level {
     std::array<Axis, 3> axes;
@@ -89,6 +99,7 @@ class MultilevelCorrection {
   };
 
   void build_levels(Eigen::Index exact_limit);
+  static void add_restriction_terms(Axis& axis, int points);
   void assemble(const lattice::Lattice& lattice, double volume_force_factor, double scale,
                 const DofMap& map, const Eigen::Matrix3Xd* state);
   // The coarsest level's matrix from its diagonal and neighbour blocks (LevelAssembler), and

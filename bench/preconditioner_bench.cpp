@@ -1,0 +1,183 @@
+// The minimisers' multilevel preconditioner at full size (solvers/preconditioner.hpp,
+// solvers/multilevel_correction.hpp): what a relaxation with `method = "minimiser"` pays for it.
+// A relaxation builds it once at its starting state and applies it about twice per L-BFGS
+// iteration (once in the two-loop recursion, once for H0's scale).
+//
+// Problem: the Fig. 4.11 pair (284,592 nodes) and the Fig. 4.25 helix (993,168 nodes) from their
+// run files, every node displaced at random by up to 0.05 l_e (fixed seed) as the state the
+// preconditioner is linearised at, the free coordinates those left by holding all six faces (as
+// the hysteresis runs of Chapter 4 do).
+// Printed with 1 and 2 threads (best of the repeats): the build (the diagonal, the particles'
+// rigid blocks and the multilevel correction's assembly and coarse factor), one application of
+// the whole preconditioner and of the multilevel correction alone, and the application as
+// nodes per second. Also printed: whether the results with 2 threads are bitwise those with 1,
+// and a 64-bit fingerprint of the applied vector, so that two builds of this bench can be
+// compared for bitwise equal results; and the load average (the machine is shared).
+//
+//   ./build/preconditioner_bench [--repeats 10] [--only fig4_11|fig4_25_helix]
+#include <omp.h>
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <random>
+#include <string>
+
+#include "mresim/config/table_reader.hpp"
+#include "mresim/mess/protocols/protocol_runner.hpp"
+#include "mresim/mess/run_file/mess_spec.hpp"
+#include "mresim/mess/solvers/preconditioner.hpp"
+
+namespace {
+
+namespace mess = mresim::mess;
+
+struct SystemFile {
+  const char* name;
+  const char* path;  // relative to the source tree
+};
+
+constexpr SystemFile kSystems[] = {
+    {"fig4_11", "examples/chapter4/fig4_11_pair_large_box_S6_5um.toml"},
+    {"fig4_25_helix", "examples/chapter4/fig4_25_helix_R3_5um.toml"},
+};
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+template <class F>
+double best_seconds(int repeats, F&& f) {
+  double best = 1e300;
+  for (int k = 0; k < repeats; ++k) {
+    const auto start = std::chrono::steady_clock::now();
+    f();
+    best = std::min(best, seconds_since(start));
+  }
+  return best;
+}
+
+// FNV-1a over the bits of v: equal fingerprints, bitwise equal vectors (up to collisions).
+std::uint64_t fingerprint(const Eigen::VectorXd& v) {
+  std::uint64_t hash = 0xcbf29ce484222325ULL;
+  for (Eigen::Index k = 0; k < v.size(); ++k) {
+    const auto bits = std::bit_cast<std::uint64_t>(v[k]);
+    for (int byte = 0; byte < 8; ++byte) {
+      hash ^= (bits >> (8 * byte)) & 0xffU;
+      hash *= 0x100000001b3ULL;
+    }
+  }
+  return hash;
+}
+
+struct Measured {
+  double build = 0.0;       // s
+  double apply = 0.0;       // s per application of P
+  double correction = 0.0;  // s per application of the multilevel correction alone
+  Eigen::VectorXd applied;  // P v
+};
+
+Measured measure(const mess::MessSystem& system, const mess::DofMap& map, double force_scale,
+                 const Eigen::VectorXd& v, int threads, int repeats) {
+  omp_set_num_threads(threads);
+  Measured m;
+  std::unique_ptr<mess::RigidParticlePreconditioner> p;
+  // The build allocates and first-touches everything it keeps: best of a few, one held at a
+  // time as in a run.
+  m.build = best_seconds(std::clamp(repeats / 4, 1, 3), [&] {
+    p.reset();
+    p = std::make_unique<mess::RigidParticlePreconditioner>(system, map, force_scale, true,
+                                                            &system.positions());
+  });
+  if (p->multilevel() == nullptr) {
+    std::fprintf(stderr, "the multilevel correction was left out (nothing held)\n");
+    std::exit(1);
+  }
+  m.applied = p->apply(map, v);  // warm-up
+  m.apply = best_seconds(repeats, [&] { m.applied = p->apply(map, v); });
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(v.size());
+  m.correction = best_seconds(repeats, [&] {
+    w.setZero();
+    p->multilevel()->add_to(map, v, w);
+  });
+  return m;
+}
+
+void run_system(const SystemFile& file, int repeats) {
+  const std::string path = std::string(MRESIM_SOURCE_DIR) + "/" + file.path;
+  const mresim::mess_config::MessSpec spec =
+      mresim::mess_config::read_mess_run_file(mresim::config::TableReader::parse_file(path));
+  const mresim::mess_protocol::ProtocolRunner runner(spec);
+  mess::MessSystem system = runner.system();
+  const std::int64_t nodes = system.node_count();
+  std::mt19937_64 random(20261205);
+  std::uniform_real_distribution<double> jitter(-0.05, 0.05);
+  Eigen::Matrix3Xd x = system.positions();
+  for (Eigen::Index n = 0; n < x.cols(); ++n) {
+    for (int a = 0; a < 3; ++a) x(a, n) += jitter(random) * system.length_scale();
+  }
+  system.set_positions(x);
+  // All six faces held, as the hysteresis runs of Chapter 4 hold them.
+  mess::BoundaryConstraints held = mess::BoundaryConstraints::none(nodes);
+  for (const auto face :
+       {mresim::lattice::Face::left, mresim::lattice::Face::right, mresim::lattice::Face::front,
+        mresim::lattice::Face::back, mresim::lattice::Face::bottom, mresim::lattice::Face::top}) {
+    held.fix_face(system.lattice().shape, face, x);
+  }
+  system.set_constraints(std::move(held));
+  system.apply_constraints();
+  const double l_e = system.length_scale();
+  const mess::DofMap map(system.constraints(), system.positions(), l_e);
+  const double force_scale = 1e-9;  // any fixed scale: P scales with l_e / force_scale
+  std::normal_distribution<double> normal;
+  Eigen::VectorXd v(map.size());
+  for (Eigen::Index k = 0; k < v.size(); ++k) v[k] = normal(random);
+
+  std::printf("\n%s: %lld nodes, %lld free coordinates\n", file.name, static_cast<long long>(nodes),
+              static_cast<long long>(map.size()));
+  Eigen::VectorXd first;
+  for (const int threads : {1, 2}) {
+    const Measured m = measure(system, map, force_scale, v, threads, repeats);
+    std::printf(
+        "  %d thread%s: build %7.3f s; apply P %7.2f ms = %6.1f M nodes/s, of which the multilevel "
+        "correction %7.2f ms; fingerprint of P v %016llx\n",
+        threads, threads == 1 ? " " : "s", m.build, 1e3 * m.apply,
+        1e-6 * static_cast<double>(nodes) / m.apply, 1e3 * m.correction,
+        static_cast<unsigned long long>(fingerprint(m.applied)));
+    if (threads == 1) {
+      first = m.applied;
+    } else {
+      std::printf("  P v with 2 threads %s the one with 1 thread\n",
+                  first == m.applied ? "bitwise equals" : "DIFFERS FROM");
+    }
+  }
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int repeats = 10;
+  std::string only;
+  for (int k = 1; k + 1 < argc; k += 2) {
+    const std::string key = argv[k];
+    if (key == "--repeats") {
+      repeats = std::max(1, std::atoi(argv[k + 1]));
+    } else if (key == "--only") {
+      only = argv[k + 1];
+    } else {
+      std::fprintf(stderr, "unknown option %s (--repeats N, --only fig4_11|fig4_25_helix)\n",
+                   argv[k]);
+      return 2;
+    }
+  }
+  double load[3] = {0, 0, 0};
+  if (getloadavg(load, 3) > 0) std::printf("load average at start: %.2f\n", load[0]);
+  for (const SystemFile& file : kSystems) {
+    if (only.empty() || only == file.name) run_system(file, repeats);
+  }
+  return 0;
+}
