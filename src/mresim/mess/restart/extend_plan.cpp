@@ -57,12 +57,14 @@ class ExtendPlan final : public app::RunPlan {
     SavedRun saved;
     std::vector<HistoryEntry> history;
     {
-      const ProtocolRunner computed(computed_spec_);
+      ProtocolRunner computed(computed_spec_);
+      computed.set_scratch_directory(staging_dir);  // kept_positions.hpp: fields wait on disk
       saved = read_saved_run(run_dir_, computed, computed_toml_);
       const io::Hdf5Reader results(run_dir_ / io::RunDirectory::kMarkerFile);
       history = read_history(results, computed);
     }
-    const ProtocolRunner extended(extended_spec_);
+    ProtocolRunner extended(extended_spec_);
+    extended.set_scratch_directory(staging_dir);
     const std::size_t shared = extension_.shared;
     const std::size_t start = last_restorable(saved, extended, shared);
     const std::size_t total = saved.steps.size();

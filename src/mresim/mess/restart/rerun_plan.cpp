@@ -75,7 +75,10 @@ class RerunPlan final : public app::RunPlan {
   void execute(const fs::path& staging_dir, io::Hdf5File& results,
                app::Progress& progress) const override {
     pair::runs::print_warnings(computed_spec_.warnings);
-    const ProtocolRunner computed(computed_spec_);
+    ProtocolRunner computed(computed_spec_);
+    // The saved run's fields wait in a scratch file while one step is relaxed again, as in the
+    // run itself (kept_positions.hpp).
+    computed.set_scratch_directory(staging_dir);
     SavedRun saved = read_saved_run(run_dir_, computed, computed_toml_);
     std::vector<HistoryEntry> history;
     {
@@ -111,7 +114,10 @@ class RerunPlan final : public app::RunPlan {
     // The new result replaces the old one everywhere the run keeps it.
     saved.records[step_] = record;
     const bool positions_kept = saved.positions.contains(step_);
-    if (positions_kept) saved.positions[step_] = rerunner.system().positions();
+    if (positions_kept) {
+      saved.positions.insert_or_assign(
+          step_, SavedPositions(KeptPositions(rerunner.system().positions())));
+    }
     for (std::size_t k = 0; k < saved.steps.size(); ++k) {
       const fs::path kept = step_positions_file(run_dir_, k);
       if (k != step_ && fs::exists(kept))

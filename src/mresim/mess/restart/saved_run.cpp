@@ -21,9 +21,10 @@ std::size_t slot_of(const StepSpec& step, std::size_t slots) {
   return slots > 1 ? step.field_index : 0;
 }
 
-// The final state's slots and references hold the results of these steps.
-void take_final_state(const ProtocolState& final, const std::vector<StepSpec>& steps,
-                      std::map<std::size_t, Eigen::Matrix3Xd>& positions) {
+// The final state's slots and references hold the results of these steps: their arrays move
+// over as they are (parked or in memory).
+void take_final_state(ProtocolState& final, const std::vector<StepSpec>& steps,
+                      std::map<std::size_t, SavedPositions>& positions) {
   std::vector<std::optional<std::size_t>> last_in_slot(final.slots.size());
   std::vector<std::optional<std::size_t>> reference_step(final.references.size());
   for (std::size_t k = 0; k < final.next_step; ++k) {
@@ -34,12 +35,14 @@ void take_final_state(const ProtocolState& final, const std::vector<StepSpec>& s
   }
   for (std::size_t s = 0; s < last_in_slot.size(); ++s) {
     if (last_in_slot[s] && final.slots[s].positions.cols() > 0) {
-      positions[*last_in_slot[s]] = final.slots[s].positions.load();
+      positions.insert_or_assign(*last_in_slot[s],
+                                 SavedPositions(std::move(final.slots[s].positions)));
     }
   }
   for (std::size_t f = 0; f < reference_step.size(); ++f) {
     if (reference_step[f] && final.references[f].cols() > 0) {
-      positions[*reference_step[f]] = final.references[f].load();
+      positions.insert_or_assign(*reference_step[f],
+                                 SavedPositions(std::move(final.references[f])));
     }
   }
 }
@@ -54,7 +57,7 @@ SavedRun read_saved_run(const fs::path& dir, const ProtocolRunner& runner,
   std::error_code ec;
   if (fs::exists(final_state, ec)) {
     // The exact records (results.h5 writes non-finite numbers as NaN) and the final positions.
-    const ProtocolState final = read_checkpoint(final_state, runner, input_toml);
+    ProtocolState final = read_checkpoint(final_state, runner, input_toml);
     if (final.next_step != saved.steps.size()) {
       throw std::runtime_error(fmt::format("{} holds the state after {} of {} steps",
                                            final_state.string(), final.next_step,
@@ -77,10 +80,15 @@ SavedRun read_saved_run(const fs::path& dir, const ProtocolRunner& runner,
   for (std::size_t k = 0; k < saved.steps.size(); ++k) {
     const fs::path file = step_positions_file(dir, k);
     if (saved.positions.contains(k) || !fs::exists(file, ec)) continue;
-    const io::Hdf5Reader in(file);
-    saved.positions[k] = read_columns(in, "/positions");
+    saved.positions.emplace(k, SavedPositions(file));
   }
   return saved;
+}
+
+Eigen::Matrix3Xd SavedPositions::load() const {
+  if (file_.empty()) return kept_.load();
+  const io::Hdf5Reader in(file_);
+  return read_columns(in, "/positions");
 }
 
 namespace {
@@ -125,11 +133,14 @@ std::optional<ProtocolState> state_after(const SavedRun& saved, const ProtocolRu
   const StateSources sources = sources_after(saved, state, count);
   for (std::size_t s = 0; s < state.slots.size(); ++s) {
     if (!sources.slots[s]) continue;
-    state.slots[s].positions = saved.positions.at(*sources.slots[s]);
+    state.slots[s].positions = saved.positions.at(*sources.slots[s]).load();
     state.slots[s].magnetization = saved.records[*sources.slots[s]].magnetization;
+    runner.park_kept_positions(state);  // one array in memory at a time where the runner parks
   }
   for (std::size_t f = 0; f < state.references.size(); ++f) {
-    if (sources.references[f]) state.references[f] = saved.positions.at(*sources.references[f]);
+    if (!sources.references[f]) continue;
+    state.references[f] = saved.positions.at(*sources.references[f]).load();
+    runner.park_kept_positions(state);
   }
   state.records.assign(saved.records.begin(),
                        saved.records.begin() + static_cast<std::ptrdiff_t>(count));

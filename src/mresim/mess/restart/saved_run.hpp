@@ -16,8 +16,10 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <utility>
 #include <vector>
 
+#include "mresim/mess/protocols/kept_positions.hpp"
 #include "mresim/mess/protocols/protocol_runner.hpp"
 
 namespace mresim::mess_protocol {
@@ -25,21 +27,44 @@ namespace mresim::mess_protocol {
 // In a finished run's directory: the protocol state after its last step (checkpoint format).
 inline constexpr const char* kFinalStateFile = "final_state.h5";
 
+// One step's kept positions in a saved run: its step file (positions/step_NNNNNN.h5), read
+// only when asked for, or an array held here (from the final state, parked in the scratch file
+// where the runner that read it has a scratch directory; or a rerun's new result). So reading a
+// run holds none of its step files in memory: at full size a step's positions are 7 MB (the
+// Fig. 4.11 pair) to 24 MB (the Fig. 4.25 helix, 132 steps).
+class SavedPositions {
+ public:
+  SavedPositions() = default;
+  explicit SavedPositions(std::filesystem::path step_file) : file_(std::move(step_file)) {}
+  explicit SavedPositions(KeptPositions kept) : kept_(std::move(kept)) {}
+
+  // The array (3 x N): read from the step file, or a copy of the one held.
+  [[nodiscard]] Eigen::Matrix3Xd load() const;
+  // Whether load() reads a step file.
+  [[nodiscard]] bool in_step_file() const { return !file_.empty(); }
+
+ private:
+  std::filesystem::path file_;
+  KeptPositions kept_;
+};
+
 struct SavedRun {
-  std::vector<StepSpec> steps;                        // the run's plan
-  std::vector<StepRecord> records;                    // every step's record
-  std::map<std::size_t, Eigen::Matrix3Xd> positions;  // by step, where kept
+  std::vector<StepSpec> steps;                      // the run's plan
+  std::vector<StepRecord> records;                  // every step's record
+  std::map<std::size_t, SavedPositions> positions;  // by step, where kept
   bool has_final_state = false;
 };
 
-// Reads the run in `dir` (results.h5, final_state.h5, positions/). `runner` is built from the
-// run's own run file `input_toml` (results.h5's /@input_toml). Throws std::runtime_error when
-// the files do not belong to that run file.
+// Reads the run in `dir` (results.h5, final_state.h5; of positions/ only which steps have a
+// file). `runner` is built from the run's own run file `input_toml` (results.h5's
+// /@input_toml); the final state's arrays are parked where it parks them. Throws
+// std::runtime_error when the files do not belong to that run file.
 SavedRun read_saved_run(const std::filesystem::path& dir, const ProtocolRunner& runner,
                         const std::string& input_toml);
 
 // The state `runner` has after the first `count` steps of `saved` (which must be its first
-// `count` steps too), or nothing when a position it needs was not kept.
+// `count` steps too), or nothing when a position it needs was not kept. Its arrays are read one
+// at a time and parked where `runner` parks them (ProtocolRunner::park_kept_positions).
 std::optional<ProtocolState> state_after(const SavedRun& saved, const ProtocolRunner& runner,
                                          std::size_t count);
 
