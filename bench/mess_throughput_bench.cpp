@@ -45,7 +45,7 @@
 #include <string>
 #include <vector>
 
-#include "mresim/config/table_reader.hpp"
+#include "full_size_systems.hpp"
 #include "mresim/mess/protocols/protocol_runner.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
 #include "mresim/mess/terms/elastic_terms.hpp"
@@ -53,20 +53,9 @@
 namespace {
 
 namespace mess = mresim::mess;
-
-struct SystemFile {
-  const char* name;
-  const char* path;  // relative to the source tree
-};
-
-constexpr SystemFile kSystems[] = {
-    {"fig4_11", "examples/chapter4/fig4_11_pair_large_box_S6_5um.toml"},
-    {"fig4_25_helix", "examples/chapter4/fig4_25_helix_R3_5um.toml"},
-};
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
+using mresim::bench::best_seconds;
+using mresim::bench::seconds_since;
+using mresim::bench::SystemFile;
 
 // STREAM-like triad with `threads` threads: best bandwidth of five passes, bytes/s.
 double triad_bandwidth(int threads) {
@@ -103,18 +92,6 @@ double elastic_bytes_per_node(const mresim::lattice::Lattice& lattice) {
 }
 constexpr double kStencilBytesPerNode = 24.0 + 24.0 + 1.0;
 
-// Best time of `repeats` calls of f().
-template <class F>
-double best_seconds(int repeats, F&& f) {
-  double best = 1e300;
-  for (int k = 0; k < repeats; ++k) {
-    const auto start = std::chrono::steady_clock::now();
-    f();
-    best = std::min(best, seconds_since(start));
-  }
-  return best;
-}
-
 struct Measured {
   double whole = 0.0;    // s per evaluation
   double elastic = 0.0;  // s per evaluation
@@ -141,22 +118,14 @@ Measured measure(mess::MessSystem& system, const mess::ElasticTerms& elastic, in
 }
 
 void run_system(const SystemFile& file, int repeats, const double bandwidth[3]) {
-  const std::string path = std::string(MRESIM_SOURCE_DIR) + "/" + file.path;
-  const mresim::mess_config::MessSpec spec =
-      mresim::mess_config::read_mess_run_file(mresim::config::TableReader::parse_file(path));
+  const mresim::mess_config::MessSpec spec = mresim::bench::read_system_spec(file);
   const auto build_start = std::chrono::steady_clock::now();
   const mresim::mess_protocol::ProtocolRunner runner(spec);
   mess::MessSystem system = runner.system();
   const double build_seconds = seconds_since(build_start);
   const std::int64_t nodes = system.node_count();
-  // Strain every spring and cell: random displacements of up to 0.05 l_e (fixed seed).
   std::mt19937_64 random(20261202);
-  std::uniform_real_distribution<double> jitter(-0.05, 0.05);
-  Eigen::Matrix3Xd x = system.positions();
-  for (Eigen::Index n = 0; n < x.cols(); ++n) {
-    for (int a = 0; a < 3; ++a) x(a, n) += jitter(random) * system.length_scale();
-  }
-  system.set_positions(x);
+  mresim::bench::displace_at_random(system, random);
   (void)system.solve_magnetization();
   const mess::ElasticTerms elastic(system.lattice(), {});
 
@@ -196,31 +165,17 @@ void run_system(const SystemFile& file, int repeats, const double bandwidth[3]) 
 }  // namespace
 
 int main(int argc, char** argv) {
-  int repeats = 5;
-  std::string only;
-  for (int k = 1; k + 1 < argc; k += 2) {
-    const std::string key = argv[k];
-    if (key == "--repeats") {
-      repeats = std::max(1, std::atoi(argv[k + 1]));
-    } else if (key == "--only") {
-      only = argv[k + 1];
-    } else {
-      std::fprintf(stderr, "unknown option %s (--repeats N, --only fig4_11|fig4_25_helix)\n",
-                   argv[k]);
-      return 2;
-    }
-  }
-  double load[3] = {0, 0, 0};
-  if (getloadavg(load, 3) > 0) std::printf("load average at start: %.2f\n", load[0]);
+  const auto options = mresim::bench::parse_bench_options(argc, argv, 5);
+  if (!options) return 2;
+  mresim::bench::print_load_average();
   double bandwidth[3] = {0.0, 0.0, 0.0};
   for (const int threads : {1, 2}) {
     bandwidth[threads] = triad_bandwidth(threads);
     std::printf("triad bandwidth, %d thread%s: %.1f GB/s\n", threads, threads == 1 ? "" : "s",
                 1e-9 * bandwidth[threads]);
   }
-  for (const SystemFile& file : kSystems) {
-    if (only.empty() || only == file.name) run_system(file, repeats, bandwidth);
-  }
+  mresim::bench::for_each_system(
+      *options, [&](const SystemFile& file) { run_system(file, options->repeats, bandwidth); });
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   std::printf("\npeak resident memory of the process: %.1f MiB\n",

@@ -17,48 +17,20 @@
 //   ./build/preconditioner_bench [--repeats 10] [--only fig4_11|fig4_25_helix]
 #include <omp.h>
 
-#include <algorithm>
 #include <bit>
-#include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <memory>
 #include <random>
-#include <string>
 
-#include "mresim/config/table_reader.hpp"
+#include "full_size_systems.hpp"
 #include "mresim/mess/protocols/protocol_runner.hpp"
-#include "mresim/mess/run_file/mess_spec.hpp"
 #include "mresim/mess/solvers/preconditioner.hpp"
 
 namespace {
 
 namespace mess = mresim::mess;
-
-struct SystemFile {
-  const char* name;
-  const char* path;  // relative to the source tree
-};
-
-constexpr SystemFile kSystems[] = {
-    {"fig4_11", "examples/chapter4/fig4_11_pair_large_box_S6_5um.toml"},
-    {"fig4_25_helix", "examples/chapter4/fig4_25_helix_R3_5um.toml"},
-};
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-template <class F>
-double best_seconds(int repeats, F&& f) {
-  double best = 1e300;
-  for (int k = 0; k < repeats; ++k) {
-    const auto start = std::chrono::steady_clock::now();
-    f();
-    best = std::min(best, seconds_since(start));
-  }
-  return best;
-}
+using mresim::bench::best_seconds;
+using mresim::bench::SystemFile;
 
 // FNV-1a over the bits of v: equal fingerprints, bitwise equal vectors (up to collisions).
 std::uint64_t fingerprint(const Eigen::VectorXd& v) {
@@ -107,19 +79,12 @@ Measured measure(const mess::MessSystem& system, const mess::DofMap& map, double
 }
 
 void run_system(const SystemFile& file, int repeats) {
-  const std::string path = std::string(MRESIM_SOURCE_DIR) + "/" + file.path;
-  const mresim::mess_config::MessSpec spec =
-      mresim::mess_config::read_mess_run_file(mresim::config::TableReader::parse_file(path));
-  const mresim::mess_protocol::ProtocolRunner runner(spec);
+  const mresim::mess_protocol::ProtocolRunner runner(mresim::bench::read_system_spec(file));
   mess::MessSystem system = runner.system();
   const std::int64_t nodes = system.node_count();
   std::mt19937_64 random(20261205);
-  std::uniform_real_distribution<double> jitter(-0.05, 0.05);
-  Eigen::Matrix3Xd x = system.positions();
-  for (Eigen::Index n = 0; n < x.cols(); ++n) {
-    for (int a = 0; a < 3; ++a) x(a, n) += jitter(random) * system.length_scale();
-  }
-  system.set_positions(x);
+  mresim::bench::displace_at_random(system, random);
+  const Eigen::Matrix3Xd& x = system.positions();
   // All six faces held, as the hysteresis runs of Chapter 4 hold them.
   mess::BoundaryConstraints held = mess::BoundaryConstraints::none(nodes);
   for (const auto face :
@@ -160,24 +125,10 @@ void run_system(const SystemFile& file, int repeats) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int repeats = 10;
-  std::string only;
-  for (int k = 1; k + 1 < argc; k += 2) {
-    const std::string key = argv[k];
-    if (key == "--repeats") {
-      repeats = std::max(1, std::atoi(argv[k + 1]));
-    } else if (key == "--only") {
-      only = argv[k + 1];
-    } else {
-      std::fprintf(stderr, "unknown option %s (--repeats N, --only fig4_11|fig4_25_helix)\n",
-                   argv[k]);
-      return 2;
-    }
-  }
-  double load[3] = {0, 0, 0};
-  if (getloadavg(load, 3) > 0) std::printf("load average at start: %.2f\n", load[0]);
-  for (const SystemFile& file : kSystems) {
-    if (only.empty() || only == file.name) run_system(file, repeats);
-  }
+  const auto options = mresim::bench::parse_bench_options(argc, argv, 10);
+  if (!options) return 2;
+  mresim::bench::print_load_average();
+  mresim::bench::for_each_system(
+      *options, [&](const SystemFile& file) { run_system(file, options->repeats); });
   return 0;
 }
