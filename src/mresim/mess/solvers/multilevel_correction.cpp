@@ -286,9 +286,11 @@ class LevelAssembler {
 
   // Adds c z z^T.
   void add_term(double c) {
+    std::array<std::int64_t, 27> node_of{};  // the level point of each touched patch point
+    for (const int p : touched_) node_of[static_cast<std::size_t>(p)] = point_of(p);
     for (const int p : touched_) {
       const auto& e = patch_[static_cast<std::size_t>(p)];
-      const std::int64_t node = point_of(p);
+      const std::int64_t node = node_of[static_cast<std::size_t>(p)];
       for (std::size_t a = 0; a < 3; ++a) {
         diagonal_[static_cast<std::size_t>(3 * node) + a] += c * e[a] * e[a];
       }
@@ -298,9 +300,9 @@ class LevelAssembler {
     // needs the blocks of its neighbours K <= J (coordinates are numbered 3 J + a).
     for (const int p : touched_) {
       const auto& e = patch_[static_cast<std::size_t>(p)];
-      const std::int64_t node = point_of(p);
+      const std::int64_t node = node_of[static_cast<std::size_t>(p)];
       for (const int q : touched_) {
-        if (point_of(q) > node) continue;
+        if (node_of[static_cast<std::size_t>(q)] > node) continue;
         const auto& f = patch_[static_cast<std::size_t>(q)];
         // Patch offsets differ by at most 2 <= kReach along each axis.
         const int code = (q / 9 - p / 9 + kReach) * kWidth * kWidth +
