@@ -2,10 +2,12 @@
 
 // What the full-size benches share (mess_throughput_bench, preconditioner_bench): the two
 // full-size systems they build from the example run files, their command line (--repeats N,
-// --only NAME), and timing by the best of repeated calls.
+// --only NAME), timing by the best of repeated calls, and fingerprints of results' bits.
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
@@ -27,6 +29,20 @@ inline constexpr SystemFile kFullSizeSystems[] = {
     {"fig4_11", "examples/chapter4/fig4_11_pair_large_box_S6_5um.toml"},
     {"fig4_25_helix", "examples/chapter4/fig4_25_helix_R3_5um.toml"},
 };
+
+// FNV-1a over the bits of `count` doubles, continuing from `hash`: equal fingerprints, bitwise
+// equal results (up to collisions), so two builds of a bench can be compared bit for bit.
+inline std::uint64_t fingerprint(const double* values, std::int64_t count,
+                                 std::uint64_t hash = 0xcbf29ce484222325ULL) {
+  for (std::int64_t k = 0; k < count; ++k) {
+    const auto bits = std::bit_cast<std::uint64_t>(values[k]);
+    for (int byte = 0; byte < 8; ++byte) {
+      hash ^= (bits >> (8 * byte)) & 0xffU;
+      hash *= 0x100000001b3ULL;
+    }
+  }
+  return hash;
+}
 
 // The run file of `file` read from the source tree.
 inline mess_config::MessSpec read_system_spec(const SystemFile& file) {

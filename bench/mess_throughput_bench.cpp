@@ -16,13 +16,14 @@
 // five, with the same thread count. The bytes per node count every array the two elastic
 // kernels sweep once per evaluation (elastic_terms.cpp), with the lattice's own spring and cell
 // counts:
-//   springs, per spring: the first node + the property byte (stiffness, kind, the step to the
-//     second node; 5 B); the tensions stay in a ring per thread that fits the cache (not
-//     counted);
-//   volume: nothing per cell (its nodes come from the grid, lattice::GridCells); the cells'
-//     coefficients stay in two layer buffers per thread (not counted);
-//   per node, each kernel: the positions read twice (48 B), the gradient read and written
-//     (48 B); the springs' stencil (first spring and offset mask, 10 B; grid_stencil.hpp).
+//   springs, per node: the positions read (24 B), copied into three component arrays (24 B
+//     written) and read back from them (24 B; the neighbours' from cache), the stiffness index
+//     of each forward offset (13 B), the gradient read and written (48 B), the stencil's first
+//     spring and offset mask for the energy's order (10 B); the tensions stay in a ring of rows
+//     per thread that fits the cache (not counted);
+//   volume, per node: the positions read into two node planes per thread (24 B) and the
+//     gradient read and written (48 B); its cells' coefficients stay in two layer buffers per
+//     thread (not counted). Nothing is read per spring or per cell.
 // The gathers find a node's springs and cells from the grid (no incidence lists). Neighbouring
 // positions are assumed to come from cache (the best case for the layout), so the bound is
 // optimistic. The same counting for a layout without index arrays or scratch (positions read
@@ -38,6 +39,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -82,14 +84,9 @@ double triad_bandwidth(int threads) {
 }
 
 // Bytes the elastic kernels stream per node (see the header for the counting).
-double elastic_bytes_per_node(const mresim::lattice::Lattice& lattice) {
-  const auto nodes = static_cast<double>(lattice.node_count());
-  const auto springs = static_cast<double>(lattice.springs.size());
-  const double per_spring = 5.0;
-  const double per_node_per_kernel = 48.0 + 48.0;
-  const double spring_stencil = 10.0;
-  return per_spring * springs / nodes + 2.0 * per_node_per_kernel + spring_stencil;
-}
+constexpr double kSpringBytesPerNode = 24.0 + 24.0 + 24.0 + 13.0 + 48.0 + 10.0;
+constexpr double kVolumeBytesPerNode = 24.0 + 48.0;
+constexpr double kElasticBytesPerNode = kSpringBytesPerNode + kVolumeBytesPerNode;
 constexpr double kStencilBytesPerNode = 24.0 + 24.0 + 1.0;
 
 struct Measured {
@@ -97,6 +94,7 @@ struct Measured {
   double elastic = 0.0;  // s per evaluation
   double hessian = 0.0;  // s per elastic Hessian product
   Eigen::Matrix3Xd gradient;
+  std::array<double, 2> values{};  // the whole evaluation's potential and rounding magnitude
 };
 
 Measured measure(mess::MessSystem& system, const mess::ElasticTerms& elastic, int threads,
@@ -104,7 +102,9 @@ Measured measure(mess::MessSystem& system, const mess::ElasticTerms& elastic, in
   omp_set_num_threads(threads);
   Measured m;
   m.gradient.resize(3, system.node_count());
-  (void)system.evaluate(&m.gradient);  // warm-up (first touch of the scratch arrays)
+  // Warm-up (first touch of the scratch arrays); its values are the fingerprinted ones.
+  const mess::Evaluation first = system.evaluate(&m.gradient);
+  m.values = {first.potential, first.magnitude};
   m.whole = best_seconds(repeats, [&] { (void)system.evaluate(&m.gradient); });
   Eigen::Matrix3Xd elastic_gradient(3, system.node_count());
   (void)elastic.evaluate(system.lattice(), system.positions(), &elastic_gradient);
@@ -129,7 +129,7 @@ void run_system(const SystemFile& file, int repeats, const double bandwidth[3]) 
   (void)system.solve_magnetization();
   const mess::ElasticTerms elastic(system.lattice(), {});
 
-  const double bytes = elastic_bytes_per_node(system.lattice());
+  const double bytes = kElasticBytesPerNode;
   std::printf("\n%s: %lld nodes, %zu springs, %zu cells, %zu particles (built in %.1f s)\n",
               file.name, static_cast<long long>(nodes), system.lattice().springs.size(),
               system.lattice().elements.size(), system.particle_count(), build_seconds);
@@ -157,6 +157,13 @@ void run_system(const SystemFile& file, int repeats, const double bandwidth[3]) 
     } else {
       std::printf("  gradient with 2 threads %s the one with 1 thread\n",
                   first_gradient == m.gradient ? "bitwise equals" : "DIFFERS FROM");
+      // The same bits from another build: the same fingerprint.
+      const std::uint64_t bits = mresim::bench::fingerprint(
+          m.gradient.data(), m.gradient.size(), mresim::bench::fingerprint(m.values.data(), 2));
+      std::printf(
+          "  fingerprint of the whole evaluation's gradient, potential and magnitude: "
+          "%016llx\n",
+          static_cast<unsigned long long>(bits));
     }
   }
   std::fflush(stdout);

@@ -17,7 +17,6 @@
 //   ./build/preconditioner_bench [--repeats 10] [--only fig4_11|fig4_25_helix]
 #include <omp.h>
 
-#include <bit>
 #include <cstdio>
 #include <memory>
 #include <random>
@@ -31,19 +30,6 @@ namespace {
 namespace mess = mresim::mess;
 using mresim::bench::best_seconds;
 using mresim::bench::SystemFile;
-
-// FNV-1a over the bits of v: equal fingerprints, bitwise equal vectors (up to collisions).
-std::uint64_t fingerprint(const Eigen::VectorXd& v) {
-  std::uint64_t hash = 0xcbf29ce484222325ULL;
-  for (Eigen::Index k = 0; k < v.size(); ++k) {
-    const auto bits = std::bit_cast<std::uint64_t>(v[k]);
-    for (int byte = 0; byte < 8; ++byte) {
-      hash ^= (bits >> (8 * byte)) & 0xffU;
-      hash *= 0x100000001b3ULL;
-    }
-  }
-  return hash;
-}
 
 struct Measured {
   double build = 0.0;       // s
@@ -111,7 +97,8 @@ void run_system(const SystemFile& file, int repeats) {
         "correction %7.2f ms; fingerprint of P v %016llx\n",
         threads, threads == 1 ? " " : "s", m.build, 1e3 * m.apply,
         1e-6 * static_cast<double>(nodes) / m.apply, 1e3 * m.correction,
-        static_cast<unsigned long long>(fingerprint(m.applied)));
+        static_cast<unsigned long long>(
+            mresim::bench::fingerprint(m.applied.data(), m.applied.size())));
     if (threads == 1) {
       first = m.applied;
     } else {

@@ -77,6 +77,8 @@ class SpringProperties {
   };
 
   const Entry& operator[](std::size_t s) const { return table_[index_[s]]; }
+  // Spring s's entry as an index into table().
+  std::uint8_t table_index(std::size_t s) const { return index_[s]; }
   std::size_t size() const { return index_.size(); }
   void reserve(std::size_t n) { index_.reserve(n); }
   // Appends a spring. Throws std::length_error past 256 distinct entries.

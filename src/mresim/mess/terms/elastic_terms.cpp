@@ -10,7 +10,9 @@
 
 #include "mresim/mess/lattice/volume_elements.hpp"
 #include "mresim/mess/system/fixed_order.hpp"
+#include "mresim/mess/terms/cell_rows.hpp"
 #include "mresim/mess/terms/elastic_formulas.hpp"
+#include "mresim/mess/terms/spring_rows.hpp"
 
 namespace mresim::mess {
 
@@ -76,9 +78,6 @@ void add_volume_gradient(const lattice::GridCells& elements, double kappa, doubl
 // ------------------------------------------------------------------------- SpringKernel
 
 namespace {
-
-// Nodes whose springs evaluate_with_gradient computes in one flat pass before gathering them.
-constexpr std::int64_t kChunkNodes = 512;
 
 // The energy sums of the fused kernels, bitwise those of detail::fixed_order_sums: the items
 // are split into the same blocks of kSumBlock, each thread takes a contiguous run of blocks
@@ -183,15 +182,17 @@ void check_shapes(const char* who, std::int64_t node_count, const lattice::Latti
 
 SpringKernel::SpringKernel(const lattice::Lattice& lat)
     : node_count_(lat.node_count()), stencil_(lat) {
-  // A node's backward springs come from the max_delta() nodes below it, so a ring holding the
-  // springs of that many nodes plus a chunk of kChunkNodes (13 springs each at most) never
-  // overwrites a tension that the chunk's gather still reads. No larger than the whole set is
-  // needed.
-  const std::int64_t needed =
-      std::min<std::int64_t>(13 * (stencil_.max_delta() + kChunkNodes + 1),
-                             std::max<std::int64_t>(stencil_.spring_count(), 1));
-  ring_capacity_ = 1;
-  while (ring_capacity_ < needed) ring_capacity_ *= 2;
+  // Each node's spring along each forward offset, as its stiffness table index, offset by
+  // offset (so that a row of nodes reads its springs' indices contiguously).
+  const lattice::SpringProperties& properties = lat.springs.properties;
+  stiffness_index_.assign(static_cast<std::size_t>(13 * node_count_), 0);
+  for (std::int64_t n = 0; n < node_count_; ++n) {
+    stencil_.for_each_forward_spring(n, [&](std::int64_t s, int o, std::int64_t) {
+      stiffness_index_[static_cast<std::size_t>(o * node_count_ + n)] =
+          properties.table_index(static_cast<std::size_t>(s));
+    });
+  }
+  for (const auto& entry : properties.table()) stiffness_table_.push_back(entry.stiffness);
 }
 
 ElasticValue SpringKernel::evaluate(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
@@ -210,41 +211,60 @@ ElasticValue SpringKernel::evaluate(const lattice::Lattice& lat, const Eigen::Ma
   return {sums[0], sums[1]};
 }
 
-// Every spring's tension k (l - L)/l (eq. 4.63) is computed once and gathered by both its ends
-// in the stencil's order, as SpringStencil::gather would, and the energy is summed in the
-// blocks of detail::fixed_order_sums, so the results are bitwise those of a tension pass, a
-// scratch array and a gather, for any thread count. Instead of an array of all tensions
-// (8 bytes per spring, written and read back), each thread keeps a ring of the last
-// ring_capacity_ tensions: it takes a contiguous run of the energy blocks and sweeps their
-// nodes in index order, a chunk of kChunkNodes at a time: one flat pass computes the chunk's
-// springs into the ring (the fastest form measured: docs/performance.md), then each node of
-// the chunk gathers its springs from the ring (its backward ones come from the max_delta()
-// nodes below it, computed earlier). A thread first computes the springs of the max_delta()
-// nodes before its own (those tensions are the previous thread's to sum), and the forward
-// springs of its last node may reach into the next thread's blocks; the energy counts only its
-// own blocks.
+// The springs row by row along z (node n = iz + nz (ix + nx iy), row ix + nx iy), one SIMD lane
+// per node (spring_rows.hpp), with bitwise the results of a tension pass over all springs, a
+// scratch array and SpringStencil::gather, for any thread count:
+//  - each node adds its springs' contributions in the stencil's order (its backward springs by
+//    decreasing index step, then its forward springs in offset order): the row loops go offset
+//    by offset in that order, and every lane does the same operations as the scalar gather;
+//  - the energy is summed in the blocks of detail::fixed_order_sums: each thread takes a
+//    contiguous run of the blocks, computes whole rows, and adds its own springs' energies in
+//    increasing spring index.
+// A row's tensions are kept, per offset, in a ring of the last nx + 2 rows: a node's backward
+// springs come from rows at most nx + 1 below its own. Positions are copied once into three
+// component arrays. A thread first computes the rows below its first node whose springs reach
+// it (the previous thread computes them too).
 ElasticValue SpringKernel::evaluate_with_gradient(const lattice::Lattice& lat,
                                                   const Eigen::Matrix3Xd& x,
                                                   Eigen::Matrix3Xd& gradient) const {
-  const lattice::SpringSet& sp = lat.springs;
   const std::int64_t springs = stencil_.spring_count();
   const std::int64_t nodes = stencil_.node_count();
   std::vector<std::array<double, 2>> partial = block_partials(springs);
-  const std::array<double, 3> rest_length = elastic::rest_lengths(sp.element_length);
+  const std::array<double, 3> rest_of_kind = elastic::rest_lengths(lat.springs.element_length);
   const bool parallel = springs >= detail::kParallelMinimum;
   const std::int64_t max_threads = parallel ? omp_get_max_threads() : 1;
-  rings_.resize(static_cast<std::size_t>(max_threads * ring_capacity_));
-  const int nz = lat.shape.nz();
-  const int nx = lat.shape.nx();
-  const std::int64_t behind = stencil_.max_delta();
-  const auto mask = static_cast<std::uint64_t>(ring_capacity_ - 1);
+  const int nx = stencil_.shape().nx();
+  const int ny = stencil_.shape().ny();
+  const int nz = stencil_.shape().nz();
+  const std::array<std::int64_t, 13>& delta = stencil_.deltas();
+  std::array<double, 13> rest_length{};  // by forward offset
+  for (std::size_t o = 0; o < 13; ++o) {
+    rest_length[o] = rest_of_kind[static_cast<std::size_t>(
+        lattice::kind_of_offset(lattice::kForwardNeighbours[o]))];
+  }
+  const std::int64_t ring_rows = nx + 2;
+  // Per thread: the tension ring, the current row's energies and roundings (13 nz each) and
+  // its nodes' gradients (3 nz).
+  const std::int64_t scratch_per_thread = (ring_rows * 13 + 26 + 3) * std::int64_t{nz};
+  row_scratch_.resize(static_cast<std::size_t>(max_threads * scratch_per_thread));
+  components_.resize(static_cast<std::size_t>(3 * nodes));
+  double* const cx = components_.data();
+  double* const cy = cx + nodes;
+  double* const cz = cy + nodes;
+  const auto at = [&](std::int64_t n) { return spring_rows::Components{cx + n, cy + n, cz + n}; };
 
 #pragma omp parallel if (parallel)
   {
+#pragma omp for schedule(static)
+    for (std::int64_t n = 0; n < nodes; ++n) {
+      cx[n] = x(0, n);
+      cy[n] = x(1, n);
+      cz[n] = x(2, n);
+    }
     const auto threads = static_cast<std::int64_t>(omp_get_num_threads());
     const auto thread = static_cast<std::int64_t>(omp_get_thread_num());
     // This thread's energy blocks, their springs `own`, and the nodes whose first spring lies
-    // there (the last thread also takes the last node, which has none).
+    // there (the last thread also takes the last node, which has none): it gathers those.
     const ItemRange own = own_items(springs, thread, threads);
     const auto first_node_from = [&](std::int64_t spring) {
       std::int64_t lo = 0;
@@ -261,45 +281,83 @@ ElasticValue SpringKernel::evaluate_with_gradient(const lattice::Lattice& lat,
     };
     const std::int64_t node_begin = first_node_from(own.begin);
     const std::int64_t node_end = thread + 1 == threads ? nodes : first_node_from(own.end);
-    double* ring = rings_.data() + thread * ring_capacity_;
+    // The node before node_begin may have springs on both sides of own.begin.
+    const std::int64_t energy_begin = std::max<std::int64_t>(0, node_begin - 1);
+    double* const scratch = row_scratch_.data() + thread * scratch_per_thread;
+    double* const energy = scratch + ring_rows * 13 * nz;
+    double* const rounding = energy + 13 * nz;
+    double* const gx = rounding + 13 * nz;
+    double* const gy = gx + nz;
+    double* const gz = gy + nz;
+    const auto tensions_of_row = [&](std::int64_t row) {
+      return scratch + (row % ring_rows) * 13 * nz;
+    };
 
     OwnBlockSums sums(own, partial);
-    // Tensions of the springs of the nodes [next, end), in one flat pass as a whole-array
-    // pass would do it, into the ring; the energy of those that are this thread's.
-    std::int64_t next = std::max<std::int64_t>(0, node_begin - behind);
-    const auto compute_through = [&](std::int64_t end) {
-      const std::int64_t stop = stencil_.first_spring(end);
-      for (std::int64_t s = stencil_.first_spring(next); s < stop; ++s) {
-        const elastic::SpringValue value = spring_at(sp, rest_length, x, s);
-        ring[static_cast<std::uint64_t>(s) & mask] = value.tension;
-        sums.add(s, value.energy, value.rounding);
+    const std::int64_t row_end = node_end > energy_begin ? (node_end - 1) / nz + 1 : 0;
+    for (std::int64_t row = std::max<std::int64_t>(0, energy_begin / nz - nx - 1); row < row_end;
+         ++row) {
+      const int ix = static_cast<int>(row % nx);
+      const int iy = static_cast<int>(row / nx);
+      const std::int64_t row_node = row * nz;
+      double* const tension = tensions_of_row(row);
+      // Tensions and energies of the row's springs, offset by offset.
+      for (std::size_t o = 0; o < 13; ++o) {
+        const auto& [dx, dy, dz] = lattice::kForwardNeighbours[o];
+        if (ix + dx < 0 || ix + dx >= nx || iy + dy < 0 || iy + dy >= ny) continue;
+        const std::int64_t lo = std::max(0, -dz);
+        const std::int64_t hi = std::min(nz, nz - dz);
+        const std::int64_t n = row_node + lo;
+        spring_rows::tensions(hi - lo, at(n), at(n + delta[o]),
+                              stiffness_index_.data() + static_cast<std::int64_t>(o) * nodes + n,
+                              stiffness_table_.data(), rest_length[o], tension + o * nz + lo,
+                              energy + o * nz + lo, rounding + o * nz + lo);
       }
-      next = end;
-    };
-    compute_through(node_begin);  // the backward springs of this thread's first nodes
-    // Grid coordinates of node n = iz + nz (ix + nx iy), advanced with n.
-    int iz = static_cast<int>(node_begin % nz);
-    int ix = static_cast<int>((node_begin / nz) % nx);
-    int iy = static_cast<int>(node_begin / nz / nx);
-    for (std::int64_t chunk = node_begin; chunk < node_end; chunk += kChunkNodes) {
-      const std::int64_t chunk_end = std::min(chunk + kChunkNodes, node_end);
-      compute_through(chunk_end);
-      for (std::int64_t n = chunk; n < chunk_end; ++n) {
-        const auto contribution = [&](std::int64_t s, std::int64_t first, std::int64_t second) {
-          const Eigen::Vector3d r = x.col(second) - x.col(first);
-          return Eigen::Vector3d(ring[static_cast<std::uint64_t>(s) & mask] * r);
-        };
-        Eigen::Vector3d g = stencil_.gather_backward(n, ix, iy, iz, gradient.col(n), contribution);
-        stencil_.for_each_forward_spring(
-            n, [&](std::int64_t s, int, std::int64_t second) { g -= contribution(s, n, second); });
-        gradient.col(n) = g;
-        if (++iz == nz) {
-          iz = 0;
-          if (++ix == nx) {
-            ix = 0;
-            ++iy;
-          }
-        }
+      // The energy of this thread's springs, in increasing spring index.
+      const std::int64_t sum_begin = std::max(row_node, energy_begin);
+      const std::int64_t sum_end = std::min(row_node + nz, node_end);
+      for (std::int64_t n = sum_begin; n < sum_end; ++n) {
+        const std::int64_t iz = n - row_node;
+        stencil_.for_each_forward_spring(n, [&](std::int64_t s, int o, std::int64_t) {
+          sums.add(s, energy[o * nz + iz], rounding[o * nz + iz]);
+        });
+      }
+      // The gradient of this thread's nodes in the row.
+      const std::int64_t lo_node = std::max(row_node, node_begin);
+      const std::int64_t hi_node = std::min(row_node + nz, node_end);
+      if (lo_node >= hi_node) continue;
+      const std::int64_t first_iz = lo_node - row_node;
+      const std::int64_t end_iz = hi_node - row_node;
+      for (std::int64_t iz = first_iz; iz < end_iz; ++iz) {
+        gx[iz] = gradient(0, row_node + iz);
+        gy[iz] = gradient(1, row_node + iz);
+        gz[iz] = gradient(2, row_node + iz);
+      }
+      for (const int o : stencil_.backward_order()) {  // springs from the nodes below
+        const auto& [dx, dy, dz] = lattice::kForwardNeighbours[static_cast<std::size_t>(o)];
+        if (ix - dx < 0 || ix - dx >= nx || iy - dy < 0 || iy - dy >= ny) continue;
+        const std::int64_t lo = std::max<std::int64_t>(first_iz, dz);
+        const std::int64_t hi = std::min<std::int64_t>(end_iz, nz + dz);
+        if (lo >= hi) continue;
+        const std::int64_t n = row_node + lo;
+        const double* from = tensions_of_row(row - dx - std::int64_t{nx} * dy) + o * nz + lo - dz;
+        spring_rows::add_backward(hi - lo, from, at(n - delta[static_cast<std::size_t>(o)]), at(n),
+                                  gx + lo, gy + lo, gz + lo);
+      }
+      for (std::size_t o = 0; o < 13; ++o) {  // springs to the nodes above
+        const auto& [dx, dy, dz] = lattice::kForwardNeighbours[o];
+        if (ix + dx < 0 || ix + dx >= nx || iy + dy < 0 || iy + dy >= ny) continue;
+        const std::int64_t lo = std::max<std::int64_t>(first_iz, -dz);
+        const std::int64_t hi = std::min<std::int64_t>(end_iz, nz - dz);
+        if (lo >= hi) continue;
+        const std::int64_t n = row_node + lo;
+        spring_rows::subtract_forward(hi - lo, tension + o * nz + lo, at(n), at(n + delta[o]),
+                                      gx + lo, gy + lo, gz + lo);
+      }
+      for (std::int64_t iz = first_iz; iz < end_iz; ++iz) {
+        gradient(0, row_node + iz) = gx[iz];
+        gradient(1, row_node + iz) = gy[iz];
+        gradient(2, row_node + iz) = gz[iz];
       }
     }
   }
@@ -418,6 +476,10 @@ ElasticValue VolumeKernel::evaluate(const lattice::Lattice& lat, const Eigen::Ma
 // blocks (the last thread also the top plane, which starts no layer); it first computes the
 // layer below its first plane, and its last layer may reach into the next thread's blocks; the
 // energy counts only its own blocks.
+// The work runs along x, one SIMD lane per cell or node (cell_rows.hpp): the two node planes
+// of a layer are copied x fastest into three component arrays, the layer buffers hold each of
+// the nine coefficients as an array over the layer's cells, and a node row gathers its cells
+// one vertex offset at a time in the stencil's order, which every lane keeps.
 ElasticValue VolumeKernel::evaluate_with_gradient(const lattice::Lattice& lat,
                                                   const Eigen::Matrix3Xd& x, double force_factor,
                                                   Eigen::Matrix3Xd& gradient) const {
@@ -428,12 +490,17 @@ ElasticValue VolumeKernel::evaluate_with_gradient(const lattice::Lattice& lat,
   const int nx = lat.shape.nx();
   const int ny = lat.shape.ny();
   const int nz = lat.shape.nz();
-  const std::int64_t layer = std::int64_t{nx - 1} * (ny - 1);  // cells per layer
-  const std::int64_t layers = cells / layer;                   // nz - 1
+  const std::int64_t row_cells = nx - 1;             // cells along x
+  const std::int64_t layer = row_cells * (ny - 1);   // cells per layer
+  const std::int64_t plane = std::int64_t{nx} * ny;  // nodes per plane
+  const std::int64_t layers = cells / layer;         // nz - 1
   std::vector<std::array<double, 2>> partial = block_partials(cells);
   const bool parallel = cells >= detail::kParallelMinimum;
   const std::int64_t max_threads = parallel ? omp_get_max_threads() : 1;
-  layer_buffers_.resize(static_cast<std::size_t>(max_threads * 2 * 9 * layer));
+  // Per thread: two node planes (3 components each), two coefficient layers (9 arrays each),
+  // one cell row's energies and roundings, one node row's gradients.
+  const std::int64_t scratch_per_thread = 2 * 3 * plane + 2 * 9 * layer + 2 * row_cells + 3 * nx;
+  layer_buffers_.resize(static_cast<std::size_t>(max_threads * scratch_per_thread));
 
 #pragma omp parallel if (parallel)
   {
@@ -448,31 +515,78 @@ ElasticValue VolumeKernel::evaluate_with_gradient(const lattice::Lattice& lat,
         std::max<std::int64_t>(0, std::min(plane_begin - 1, own.begin / layer));
     const std::int64_t layer_end =
         std::min(layers, std::max(plane_end, own.end > own.begin ? (own.end - 1) / layer + 1 : 0));
-    double* buffers = layer_buffers_.data() + thread * 2 * 9 * layer;
-    OwnBlockSums sums(own, partial);
-    const auto gather_plane = [&](std::int64_t iz) {
-      for (int iy = 0; iy < ny; ++iy) {
-        for (int ix = 0; ix < nx; ++ix) {
-          const std::int64_t n = iz + std::int64_t{nz} * (ix + std::int64_t{nx} * iy);
-          gradient.col(n) = stencil_.gather_node(
-              ix, iy, static_cast<int>(iz), gradient.col(n), [&](std::int64_t cell, int v) {
-                const std::int64_t cz = iz - (v & 1);  // the node is the cell's vertex dz = v & 1
-                return elastic::vertex_gradient(
-                    buffers + 9 * ((cz & 1) * layer + (cell - cz * layer)), v);
-              });
+    double* const planes = layer_buffers_.data() + thread * scratch_per_thread;
+    double* const coefficients = planes + 2 * 3 * plane;
+    double* const energy = coefficients + 2 * 9 * layer;
+    double* const rounding = energy + row_cells;
+    double* const gx = rounding + row_cells;
+    double* const gy = gx + nx;
+    double* const gz = gy + nx;
+    const auto plane_of = [&](std::int64_t iz) { return planes + (iz & 1) * 3 * plane; };
+    const auto layer_of = [&](std::int64_t cz) { return coefficients + (cz & 1) * 9 * layer; };
+    const auto node_of = [&](std::int64_t ix, std::int64_t iy, std::int64_t iz) {
+      return iz + nz * (ix + nx * iy);
+    };
+    const auto load_plane = [&](std::int64_t iz) {
+      double* p = plane_of(iz);
+      for (std::int64_t iy = 0; iy < ny; ++iy) {
+        for (std::int64_t ix = 0; ix < nx; ++ix, ++p) {
+          const std::int64_t n = node_of(ix, iy, iz);
+          p[0] = x(0, n);
+          p[plane] = x(1, n);
+          p[2 * plane] = x(2, n);
         }
       }
     };
+    OwnBlockSums sums(own, partial);
+    const auto gather_plane = [&](std::int64_t iz) {
+      for (std::int64_t iy = 0; iy < ny; ++iy) {
+        for (std::int64_t ix = 0; ix < nx; ++ix) {
+          const std::int64_t n = node_of(ix, iy, iz);
+          gx[ix] = gradient(0, n);
+          gy[ix] = gradient(1, n);
+          gz[ix] = gradient(2, n);
+        }
+        for (const auto& [dx, dy, dz] : kCellsOfNode) {  // cell (ix - dx, iy - dy, iz - dz)
+          const std::int64_t cy = iy - dy;
+          const std::int64_t cz = iz - dz;
+          if (cy < 0 || cy >= ny - 1 || cz < 0 || cz >= layers) continue;
+          const double* const row = layer_of(cz) + row_cells * cy;
+          cell_rows::Coefficients<const double*> t{};
+          for (std::size_t k = 0; k < 9; ++k) t[k] = row + static_cast<std::int64_t>(k) * layer;
+          // The node is local vertex 2 dx + 4 dy + dz: signs s_a, s_b, s_c by dx, dy, dz.
+          cell_rows::add_vertex_gradient(row_cells, t, dx == 1 ? 1.0 : -1.0, dy == 1 ? 1.0 : -1.0,
+                                         dz == 1 ? 1.0 : -1.0, gx + dx, gy + dx, gz + dx);
+        }
+        for (std::int64_t ix = 0; ix < nx; ++ix) {
+          const std::int64_t n = node_of(ix, iy, iz);
+          gradient(0, n) = gx[ix];
+          gradient(1, n) = gy[ix];
+          gradient(2, n) = gz[ix];
+        }
+      }
+    };
+    if (layer_begin < layer_end) load_plane(layer_begin);
     for (std::int64_t cz = layer_begin; cz < layer_end; ++cz) {
-      double* t = buffers + 9 * (cz & 1) * layer;
-      std::int64_t c = cz * layer;
-      for (int cy = 0; cy < ny - 1; ++cy) {
-        for (int cx = 0; cx < nx - 1; ++cx, ++c, t += 9) {
-          // The cell's nodes from the grid: its lower corner plus the vertex steps.
-          const std::int64_t corner = cz + std::int64_t{nz} * (cx + std::int64_t{nx} * cy);
-          const elastic::CellValue value = elastic::cell_value(
-              gather_vertices(lat.elements.cell_at(corner), x), kappa, v0, force_factor, t);
-          sums.add(c, value.energy, value.rounding);
+      load_plane(cz + 1);
+      for (std::int64_t cy = 0; cy < ny - 1; ++cy) {
+        cell_rows::Corners corners{};
+        for (std::size_t v = 0; v < 8; ++v) {  // local vertex v = 2 dx + 4 dy + dz
+          const std::int64_t dx = (v >> 1U) & 1U;
+          const std::int64_t dy = (v >> 2U) & 1U;
+          const std::int64_t dz = v & 1U;
+          const double* p = plane_of(cz + dz) + nx * (cy + dy) + dx;
+          corners.x[v] = p;
+          corners.y[v] = p + plane;
+          corners.z[v] = p + 2 * plane;
+        }
+        cell_rows::Coefficients<double*> t{};
+        double* const row = layer_of(cz) + row_cells * cy;
+        for (std::size_t k = 0; k < 9; ++k) t[k] = row + static_cast<std::int64_t>(k) * layer;
+        cell_rows::coefficients(row_cells, corners, kappa, v0, force_factor, t, energy, rounding);
+        const std::int64_t first_cell = cz * layer + row_cells * cy;
+        for (std::int64_t i = 0; i < row_cells; ++i) {
+          sums.add(first_cell + i, energy[i], rounding[i]);
         }
       }
       if (cz >= plane_begin && cz < plane_end) gather_plane(cz);

@@ -116,9 +116,14 @@ class SpringKernel {
   SpringStencil stencil_;  // node -> incident springs, from the grid
   // Scratch of the Hessian product: B (v_j - v_i) per spring (3 doubles).
   mutable std::vector<double> scratch_;
-  // The tension rings of evaluate_with_gradient, ring_capacity_ doubles per thread.
-  mutable std::vector<double> rings_;
-  std::int64_t ring_capacity_ = 0;  // a power of two
+  // Node n's spring along forward offset o as an index into stiffness_table_, at o N + n
+  // (0 where the offset leaves the box): a row of nodes reads one offset's contiguously.
+  std::vector<std::uint8_t> stiffness_index_;
+  std::vector<double> stiffness_table_;  // N/m, the lattice's distinct spring stiffnesses
+  // evaluate_with_gradient's scratch: the positions as three component arrays (3 N), and per
+  // thread a ring of the last nx + 2 rows' tensions with one row's energies and gradients.
+  mutable std::vector<double> components_;
+  mutable std::vector<double> row_scratch_;
 };
 
 // Volume elements, eq. 4.64 x V0, times force_factor in gradients and Hessians. Exact Hessian
@@ -156,7 +161,8 @@ class VolumeKernel {
   CellStencil stencil_;  // node -> the cells holding it, from the grid
   // Scratch of the Hessian product: per cell the three vectors t_a, t_b, t_c (see gather).
   mutable std::vector<double> scratch_;
-  // evaluate_with_gradient's two layers of cell coefficients per thread.
+  // evaluate_with_gradient's scratch per thread: two node planes, two layers of cell
+  // coefficients, a cell row's energies and a node row's gradients.
   mutable std::vector<double> layer_buffers_;
 };
 

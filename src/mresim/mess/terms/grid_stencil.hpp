@@ -67,6 +67,11 @@ class SpringStencil {
   // The largest node index step of a spring (the offset (+x, +y, +z)): a node's backward
   // springs all come from the nodes at most this far below it.
   std::int64_t max_delta() const { return *std::max_element(delta_.begin(), delta_.end()); }
+  // The node index change of each forward offset, and the offsets by decreasing change (the
+  // order of a node's backward springs).
+  const std::array<std::int64_t, 13>& deltas() const { return delta_; }
+  const std::array<int, 13>& backward_order() const { return backward_order_; }
+  const lattice::GridShape& shape() const { return shape_; }
 
   // For every node n: g = out.col(n); then, for each spring s incident to n in increasing s,
   // g += contribution(s, first, second) if n is the spring's second end, g -= ... if it is the
