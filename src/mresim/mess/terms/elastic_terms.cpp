@@ -211,9 +211,172 @@ ElasticValue SpringKernel::evaluate(const lattice::Lattice& lat, const Eigen::Ma
   return {sums[0], sums[1]};
 }
 
-// The springs row by row along z (node n = iz + nz (ix + nx iy), row ix + nx iy), one SIMD lane
-// per node (spring_rows.hpp), with bitwise the results of a tension pass over all springs, a
-// scratch array and SpringStencil::gather, for any thread count:
+namespace {
+
+// One evaluation's spring rows (SpringKernel::evaluate_with_gradient): the grid, the positions
+// as component arrays, each forward offset's rest length and stiffness indices, and the three
+// steps of a row. Row r holds the nodes r nz ... r nz + nz - 1 (node n = iz + nz (ix + nx iy),
+// row ix + nx iy); each row's arrays hold 13 x nz values, offset o's at o nz.
+class SpringRows {
+ public:
+  SpringRows(const SpringStencil& stencil, const double* components,
+             const std::array<double, 3>& rest_of_kind, const std::uint8_t* stiffness_index,
+             const double* stiffness_table)
+      : stencil_(stencil),
+        nx_(stencil.shape().nx()),
+        ny_(stencil.shape().ny()),
+        nz_(stencil.shape().nz()),
+        nodes_(stencil.node_count()),
+        components_(components),
+        stiffness_index_(stiffness_index),
+        stiffness_table_(stiffness_table) {
+    for (std::size_t o = 0; o < 13; ++o) {
+      rest_length_[o] = rest_of_kind[static_cast<std::size_t>(
+          lattice::kind_of_offset(lattice::kForwardNeighbours[o]))];
+    }
+  }
+
+  std::int64_t nx() const { return nx_; }
+  std::int64_t nz() const { return nz_; }
+
+  // A row with its grid coordinates and first node (computed once per row, not per offset).
+  struct Row {
+    std::int64_t index;
+    std::int64_t ix;
+    std::int64_t iy;
+    std::int64_t first_node;
+  };
+  Row row(std::int64_t index) const { return {index, index % nx_, index / nx_, index * nz_}; }
+
+  // Tensions, energies and rounding scales of the row's springs (eqs. 4.62-4.63).
+  void compute(const Row& row, double* tension, double* energy, double* rounding) const {
+    const std::int64_t row_node = row.first_node;
+    for (std::size_t o = 0; o < 13; ++o) {
+      const auto& [dx, dy, dz] = lattice::kForwardNeighbours[o];
+      if (!row_exists(row, dx, dy)) continue;
+      const std::int64_t lo = std::max(0, -dz);
+      const std::int64_t hi = std::min<std::int64_t>(nz_, nz_ - dz);
+      const std::int64_t n = row_node + lo;
+      const std::int64_t at = static_cast<std::int64_t>(o) * nz_ + lo;
+      spring_rows::tensions(hi - lo, components(n), components(n + delta(o)),
+                            stiffness_index_ + static_cast<std::int64_t>(o) * nodes_ + n,
+                            stiffness_table_, rest_length_[o], tension + at, energy + at,
+                            rounding + at);
+    }
+  }
+
+  // The energies of the nodes [begin, end) of the row, in increasing spring index.
+  void add_energies(const Row& row, std::int64_t begin, std::int64_t end, const double* energy,
+                    const double* rounding, OwnBlockSums& sums) const {
+    for (std::int64_t n = begin; n < end; ++n) {
+      const std::int64_t iz = n - row.first_node;
+      stencil_.for_each_forward_spring(n, [&](std::int64_t s, int o, std::int64_t) {
+        sums.add(s, energy[o * nz_ + iz], rounding[o * nz_ + iz]);
+      });
+    }
+  }
+
+  // g += the backward springs' contributions for the row's nodes [first_iz, end_iz), offset by
+  // offset in the stencil's order; tensions_of(r) gives row r's tensions.
+  template <class Tensions>
+  void add_backward(const Row& row, std::int64_t first_iz, std::int64_t end_iz,
+                    Tensions&& tensions_of, double* gx, double* gy, double* gz) const {
+    for (const int o : stencil_.backward_order()) {
+      const auto& [dx, dy, dz] = lattice::kForwardNeighbours[static_cast<std::size_t>(o)];
+      if (!row_exists(row, -dx, -dy)) continue;
+      const std::int64_t lo = std::max<std::int64_t>(first_iz, dz);
+      const std::int64_t hi = std::min<std::int64_t>(end_iz, nz_ + dz);
+      if (lo >= hi) continue;
+      const std::int64_t n = row.first_node + lo;
+      const double* from = tensions_of(row.index - dx - nx_ * dy) + o * nz_ + lo - dz;
+      spring_rows::add_backward(hi - lo, from, components(n - delta(static_cast<std::size_t>(o))),
+                                components(n), gx + lo, gy + lo, gz + lo);
+    }
+  }
+
+  // g -= the forward springs' contributions for the row's nodes [first_iz, end_iz).
+  void subtract_forward(const Row& row, std::int64_t first_iz, std::int64_t end_iz,
+                        const double* tension, double* gx, double* gy, double* gz) const {
+    for (std::size_t o = 0; o < 13; ++o) {
+      const auto& [dx, dy, dz] = lattice::kForwardNeighbours[o];
+      if (!row_exists(row, dx, dy)) continue;
+      const std::int64_t lo = std::max<std::int64_t>(first_iz, -dz);
+      const std::int64_t hi = std::min<std::int64_t>(end_iz, nz_ - dz);
+      if (lo >= hi) continue;
+      const std::int64_t n = row.first_node + lo;
+      spring_rows::subtract_forward(hi - lo, tension + static_cast<std::int64_t>(o) * nz_ + lo,
+                                    components(n), components(n + delta(o)), gx + lo, gy + lo,
+                                    gz + lo);
+    }
+  }
+
+ private:
+  // Whether the row (dx, dy) away from `row` lies in the grid.
+  bool row_exists(const Row& row, int dx, int dy) const {
+    const std::int64_t ix = row.ix + dx;
+    const std::int64_t iy = row.iy + dy;
+    return ix >= 0 && ix < nx_ && iy >= 0 && iy < ny_;
+  }
+  std::int64_t delta(std::size_t o) const { return stencil_.deltas()[o]; }
+  spring_rows::Components components(std::int64_t n) const {
+    return {components_ + n, components_ + nodes_ + n, components_ + 2 * nodes_ + n};
+  }
+
+  const SpringStencil& stencil_;
+  std::int64_t nx_;
+  std::int64_t ny_;
+  std::int64_t nz_;
+  std::int64_t nodes_;
+  const double* components_;  // x, y and z of every node, nodes_ apart
+  const std::uint8_t* stiffness_index_;
+  const double* stiffness_table_;
+  std::array<double, 13> rest_length_{};  // by forward offset
+};
+
+// The nodes a thread gathers, [begin, end): those whose first spring lies in its own energy
+// blocks `own` (the last thread also takes the last node, which has none).
+ItemRange nodes_of_thread(const SpringStencil& stencil, ItemRange own, bool last_thread) {
+  const auto first_node_from = [&](std::int64_t spring) {
+    std::int64_t lo = 0;
+    std::int64_t hi = stencil.node_count();
+    while (lo < hi) {  // the first node whose first spring is >= spring
+      const std::int64_t mid = lo + (hi - lo) / 2;
+      if (stencil.first_spring(mid) < spring) {
+        lo = mid + 1;
+      } else {
+        hi = mid;
+      }
+    }
+    return lo;
+  };
+  return {first_node_from(own.begin),
+          last_thread ? stencil.node_count() : first_node_from(own.end)};
+}
+
+// Copies columns row_node + [begin, end) of the 3 x N matrix m into or out of a row's
+// component arrays (entries [begin, end)).
+void load_row(const Eigen::Matrix3Xd& m, std::int64_t row_node, std::int64_t begin,
+              std::int64_t end, double* gx, double* gy, double* gz) {
+  for (std::int64_t i = begin; i < end; ++i) {
+    gx[i] = m(0, row_node + i);
+    gy[i] = m(1, row_node + i);
+    gz[i] = m(2, row_node + i);
+  }
+}
+void store_row(const double* gx, const double* gy, const double* gz, std::int64_t row_node,
+               std::int64_t begin, std::int64_t end, Eigen::Matrix3Xd& m) {
+  for (std::int64_t i = begin; i < end; ++i) {
+    m(0, row_node + i) = gx[i];
+    m(1, row_node + i) = gy[i];
+    m(2, row_node + i) = gz[i];
+  }
+}
+
+}  // namespace
+
+// The springs row by row along z, one SIMD lane per node (spring_rows.hpp), with bitwise the
+// results of a tension pass over all springs, a scratch array and SpringStencil::gather, for
+// any thread count:
 //  - each node adds its springs' contributions in the stencil's order (its backward springs by
 //    decreasing index step, then its forward springs in offset order): the row loops go offset
 //    by offset in that order, and every lane does the same operations as the scalar gather;
@@ -230,135 +393,61 @@ ElasticValue SpringKernel::evaluate_with_gradient(const lattice::Lattice& lat,
   const std::int64_t springs = stencil_.spring_count();
   const std::int64_t nodes = stencil_.node_count();
   std::vector<std::array<double, 2>> partial = block_partials(springs);
-  const std::array<double, 3> rest_of_kind = elastic::rest_lengths(lat.springs.element_length);
   const bool parallel = springs >= detail::kParallelMinimum;
   const std::int64_t max_threads = parallel ? omp_get_max_threads() : 1;
-  const int nx = stencil_.shape().nx();
-  const int ny = stencil_.shape().ny();
-  const int nz = stencil_.shape().nz();
-  const std::array<std::int64_t, 13>& delta = stencil_.deltas();
-  std::array<double, 13> rest_length{};  // by forward offset
-  for (std::size_t o = 0; o < 13; ++o) {
-    rest_length[o] = rest_of_kind[static_cast<std::size_t>(
-        lattice::kind_of_offset(lattice::kForwardNeighbours[o]))];
-  }
+  components_.resize(static_cast<std::size_t>(3 * nodes));
+  const SpringRows rows(stencil_, components_.data(),
+                        elastic::rest_lengths(lat.springs.element_length), stiffness_index_.data(),
+                        stiffness_table_.data());
+  const std::int64_t nx = rows.nx();
+  const std::int64_t nz = rows.nz();
   const std::int64_t ring_rows = nx + 2;
   // Per thread: the tension ring, the current row's energies and roundings (13 nz each) and
   // its nodes' gradients (3 nz).
-  const std::int64_t scratch_per_thread = (ring_rows * 13 + 26 + 3) * std::int64_t{nz};
+  const std::int64_t scratch_per_thread = (ring_rows * 13 + 26 + 3) * nz;
   row_scratch_.resize(static_cast<std::size_t>(max_threads * scratch_per_thread));
-  components_.resize(static_cast<std::size_t>(3 * nodes));
-  double* const cx = components_.data();
-  double* const cy = cx + nodes;
-  double* const cz = cy + nodes;
-  const auto at = [&](std::int64_t n) { return spring_rows::Components{cx + n, cy + n, cz + n}; };
 
 #pragma omp parallel if (parallel)
   {
 #pragma omp for schedule(static)
     for (std::int64_t n = 0; n < nodes; ++n) {
-      cx[n] = x(0, n);
-      cy[n] = x(1, n);
-      cz[n] = x(2, n);
+      components_[static_cast<std::size_t>(n)] = x(0, n);
+      components_[static_cast<std::size_t>(nodes + n)] = x(1, n);
+      components_[static_cast<std::size_t>(2 * nodes + n)] = x(2, n);
     }
     const auto threads = static_cast<std::int64_t>(omp_get_num_threads());
     const auto thread = static_cast<std::int64_t>(omp_get_thread_num());
-    // This thread's energy blocks, their springs `own`, and the nodes whose first spring lies
-    // there (the last thread also takes the last node, which has none): it gathers those.
     const ItemRange own = own_items(springs, thread, threads);
-    const auto first_node_from = [&](std::int64_t spring) {
-      std::int64_t lo = 0;
-      std::int64_t hi = nodes;
-      while (lo < hi) {  // the first node whose first spring is >= spring
-        const std::int64_t mid = lo + (hi - lo) / 2;
-        if (stencil_.first_spring(mid) < spring) {
-          lo = mid + 1;
-        } else {
-          hi = mid;
-        }
-      }
-      return lo;
-    };
-    const std::int64_t node_begin = first_node_from(own.begin);
-    const std::int64_t node_end = thread + 1 == threads ? nodes : first_node_from(own.end);
-    // The node before node_begin may have springs on both sides of own.begin.
-    const std::int64_t energy_begin = std::max<std::int64_t>(0, node_begin - 1);
+    const ItemRange gathered = nodes_of_thread(stencil_, own, thread + 1 == threads);
+    // The node before the first gathered one may have springs on both sides of own.begin.
+    const std::int64_t energy_begin = std::max<std::int64_t>(0, gathered.begin - 1);
     double* const scratch = row_scratch_.data() + thread * scratch_per_thread;
     double* const energy = scratch + ring_rows * 13 * nz;
     double* const rounding = energy + 13 * nz;
     double* const gx = rounding + 13 * nz;
     double* const gy = gx + nz;
     double* const gz = gy + nz;
-    const auto tensions_of_row = [&](std::int64_t row) {
+    const auto tensions_of = [&](std::int64_t row) {
       return scratch + (row % ring_rows) * 13 * nz;
     };
 
     OwnBlockSums sums(own, partial);
-    const std::int64_t row_end = node_end > energy_begin ? (node_end - 1) / nz + 1 : 0;
-    for (std::int64_t row = std::max<std::int64_t>(0, energy_begin / nz - nx - 1); row < row_end;
-         ++row) {
-      const int ix = static_cast<int>(row % nx);
-      const int iy = static_cast<int>(row / nx);
-      const std::int64_t row_node = row * nz;
-      double* const tension = tensions_of_row(row);
-      // Tensions and energies of the row's springs, offset by offset.
-      for (std::size_t o = 0; o < 13; ++o) {
-        const auto& [dx, dy, dz] = lattice::kForwardNeighbours[o];
-        if (ix + dx < 0 || ix + dx >= nx || iy + dy < 0 || iy + dy >= ny) continue;
-        const std::int64_t lo = std::max(0, -dz);
-        const std::int64_t hi = std::min(nz, nz - dz);
-        const std::int64_t n = row_node + lo;
-        spring_rows::tensions(hi - lo, at(n), at(n + delta[o]),
-                              stiffness_index_.data() + static_cast<std::int64_t>(o) * nodes + n,
-                              stiffness_table_.data(), rest_length[o], tension + o * nz + lo,
-                              energy + o * nz + lo, rounding + o * nz + lo);
-      }
-      // The energy of this thread's springs, in increasing spring index.
-      const std::int64_t sum_begin = std::max(row_node, energy_begin);
-      const std::int64_t sum_end = std::min(row_node + nz, node_end);
-      for (std::int64_t n = sum_begin; n < sum_end; ++n) {
-        const std::int64_t iz = n - row_node;
-        stencil_.for_each_forward_spring(n, [&](std::int64_t s, int o, std::int64_t) {
-          sums.add(s, energy[o * nz + iz], rounding[o * nz + iz]);
-        });
-      }
+    const std::int64_t row_end = gathered.end > energy_begin ? (gathered.end - 1) / nz + 1 : 0;
+    for (std::int64_t index = std::max<std::int64_t>(0, energy_begin / nz - nx - 1);
+         index < row_end; ++index) {
+      const SpringRows::Row row = rows.row(index);
+      const std::int64_t row_node = row.first_node;
+      rows.compute(row, tensions_of(index), energy, rounding);
+      rows.add_energies(row, std::max(row_node, energy_begin),
+                        std::min(row_node + nz, gathered.end), energy, rounding, sums);
       // The gradient of this thread's nodes in the row.
-      const std::int64_t lo_node = std::max(row_node, node_begin);
-      const std::int64_t hi_node = std::min(row_node + nz, node_end);
-      if (lo_node >= hi_node) continue;
-      const std::int64_t first_iz = lo_node - row_node;
-      const std::int64_t end_iz = hi_node - row_node;
-      for (std::int64_t iz = first_iz; iz < end_iz; ++iz) {
-        gx[iz] = gradient(0, row_node + iz);
-        gy[iz] = gradient(1, row_node + iz);
-        gz[iz] = gradient(2, row_node + iz);
-      }
-      for (const int o : stencil_.backward_order()) {  // springs from the nodes below
-        const auto& [dx, dy, dz] = lattice::kForwardNeighbours[static_cast<std::size_t>(o)];
-        if (ix - dx < 0 || ix - dx >= nx || iy - dy < 0 || iy - dy >= ny) continue;
-        const std::int64_t lo = std::max<std::int64_t>(first_iz, dz);
-        const std::int64_t hi = std::min<std::int64_t>(end_iz, nz + dz);
-        if (lo >= hi) continue;
-        const std::int64_t n = row_node + lo;
-        const double* from = tensions_of_row(row - dx - std::int64_t{nx} * dy) + o * nz + lo - dz;
-        spring_rows::add_backward(hi - lo, from, at(n - delta[static_cast<std::size_t>(o)]), at(n),
-                                  gx + lo, gy + lo, gz + lo);
-      }
-      for (std::size_t o = 0; o < 13; ++o) {  // springs to the nodes above
-        const auto& [dx, dy, dz] = lattice::kForwardNeighbours[o];
-        if (ix + dx < 0 || ix + dx >= nx || iy + dy < 0 || iy + dy >= ny) continue;
-        const std::int64_t lo = std::max<std::int64_t>(first_iz, -dz);
-        const std::int64_t hi = std::min<std::int64_t>(end_iz, nz - dz);
-        if (lo >= hi) continue;
-        const std::int64_t n = row_node + lo;
-        spring_rows::subtract_forward(hi - lo, tension + o * nz + lo, at(n), at(n + delta[o]),
-                                      gx + lo, gy + lo, gz + lo);
-      }
-      for (std::int64_t iz = first_iz; iz < end_iz; ++iz) {
-        gradient(0, row_node + iz) = gx[iz];
-        gradient(1, row_node + iz) = gy[iz];
-        gradient(2, row_node + iz) = gz[iz];
-      }
+      const std::int64_t first_iz = std::max(row_node, gathered.begin) - row_node;
+      const std::int64_t end_iz = std::min(row_node + nz, gathered.end) - row_node;
+      if (first_iz >= end_iz) continue;
+      load_row(gradient, row_node, first_iz, end_iz, gx, gy, gz);
+      rows.add_backward(row, first_iz, end_iz, tensions_of, gx, gy, gz);
+      rows.subtract_forward(row, first_iz, end_iz, tensions_of(index), gx, gy, gz);
+      store_row(gx, gy, gz, row_node, first_iz, end_iz, gradient);
     }
   }
   return total_of(partial);
@@ -465,6 +554,131 @@ ElasticValue VolumeKernel::evaluate(const lattice::Lattice& lat, const Eigen::Ma
   return {sums[0], sums[1]};
 }
 
+namespace {
+
+// One thread's scratch for the cell layers (VolumeKernel::evaluate_with_gradient): two node
+// planes of positions, x fastest (plane iz in slot iz mod 2, three component arrays each), two
+// layers of cell coefficients (layer cz in slot cz mod 2, nine arrays over the layer's cells),
+// one cell row's energies and roundings and one node row's gradients; and the three steps.
+class CellLayers {
+ public:
+  CellLayers(const lattice::GridShape& shape, double* scratch)
+      : nx_(shape.nx()),
+        ny_(shape.ny()),
+        nz_(shape.nz()),
+        row_cells_(nx_ - 1),
+        layer_(row_cells_ * (ny_ - 1)),
+        plane_(nx_ * ny_),
+        planes_(scratch),
+        coefficients_(planes_ + 6 * plane_),   // two planes of three components
+        energy_(coefficients_ + 18 * layer_),  // two layers of nine coefficients
+        rounding_(energy_ + row_cells_),
+        gx_(rounding_ + row_cells_),
+        gy_(gx_ + nx_),
+        gz_(gy_ + nx_) {}
+
+  // Doubles of scratch one thread needs.
+  static std::int64_t scratch_size(const lattice::GridShape& shape) {
+    const std::int64_t row_cells = shape.nx() - 1;
+    const std::int64_t layer = row_cells * (shape.ny() - 1);
+    // Two planes of three components, two layers of nine coefficients, a row's energies and
+    // roundings, a row's gradients.
+    return 6 * (std::int64_t{shape.nx()} * shape.ny()) + 18 * layer + 2 * row_cells +
+           3 * std::int64_t{shape.nx()};
+  }
+
+  // Copies node plane iz of x into its slot.
+  void load_plane(const Eigen::Matrix3Xd& x, std::int64_t iz) {
+    double* p = plane_of(iz);
+    for (std::int64_t iy = 0; iy < ny_; ++iy) {
+      for (std::int64_t ix = 0; ix < nx_; ++ix, ++p) {
+        const std::int64_t n = node_of(ix, iy, iz);
+        p[0] = x(0, n);
+        p[plane_] = x(1, n);
+        p[2 * plane_] = x(2, n);
+      }
+    }
+  }
+
+  // The coefficients of layer cz (planes cz and cz + 1 loaded) and its cells' energies.
+  void compute_layer(std::int64_t cz, double kappa, double v0, double force_factor,
+                     OwnBlockSums& sums) {
+    for (std::int64_t cy = 0; cy < ny_ - 1; ++cy) {
+      cell_rows::Corners corners{};
+      for (std::size_t v = 0; v < 8; ++v) {  // local vertex v = 2 dx + 4 dy + dz
+        const auto dx = static_cast<std::int64_t>((v >> 1U) & 1U);
+        const auto dy = static_cast<std::int64_t>((v >> 2U) & 1U);
+        const auto dz = static_cast<std::int64_t>(v & 1U);
+        const double* p = plane_of(cz + dz) + nx_ * (cy + dy) + dx;
+        corners.x[v] = p;
+        corners.y[v] = p + plane_;
+        corners.z[v] = p + 2 * plane_;
+      }
+      cell_rows::Coefficients<double*> t{};
+      double* const row = layer_of(cz) + row_cells_ * cy;
+      for (std::size_t k = 0; k < 9; ++k) t[k] = row + static_cast<std::int64_t>(k) * layer_;
+      cell_rows::coefficients(row_cells_, corners, kappa, v0, force_factor, t, energy_, rounding_);
+      const std::int64_t first_cell = cz * layer_ + row_cells_ * cy;
+      for (std::int64_t i = 0; i < row_cells_; ++i) {
+        sums.add(first_cell + i, energy_[i], rounding_[i]);
+      }
+    }
+  }
+
+  // Node plane iz adds its cells' contributions (layers iz - 1 and iz, those in the grid), each
+  // node row one vertex offset at a time in CellStencil's order.
+  void gather_plane(std::int64_t iz, Eigen::Matrix3Xd& gradient) {
+    const std::int64_t layers = nz_ - 1;
+    for (std::int64_t iy = 0; iy < ny_; ++iy) {
+      const std::int64_t first = node_of(0, iy, iz);
+      for (std::int64_t ix = 0; ix < nx_; ++ix) {
+        gx_[ix] = gradient(0, first + nz_ * ix);
+        gy_[ix] = gradient(1, first + nz_ * ix);
+        gz_[ix] = gradient(2, first + nz_ * ix);
+      }
+      for (const auto& [dx, dy, dz] : kCellsOfNode) {  // cell (ix - dx, iy - dy, iz - dz)
+        const std::int64_t cy = iy - dy;
+        const std::int64_t cz = iz - dz;
+        if (cy < 0 || cy >= ny_ - 1 || cz < 0 || cz >= layers) continue;
+        const double* const row = layer_of(cz) + row_cells_ * cy;
+        cell_rows::Coefficients<const double*> t{};
+        for (std::size_t k = 0; k < 9; ++k) t[k] = row + static_cast<std::int64_t>(k) * layer_;
+        // The node is local vertex 2 dx + 4 dy + dz: signs s_a, s_b, s_c by dx, dy, dz.
+        cell_rows::add_vertex_gradient(row_cells_, t, dx == 1 ? 1.0 : -1.0, dy == 1 ? 1.0 : -1.0,
+                                       dz == 1 ? 1.0 : -1.0, gx_ + dx, gy_ + dx, gz_ + dx);
+      }
+      for (std::int64_t ix = 0; ix < nx_; ++ix) {
+        gradient(0, first + nz_ * ix) = gx_[ix];
+        gradient(1, first + nz_ * ix) = gy_[ix];
+        gradient(2, first + nz_ * ix) = gz_[ix];
+      }
+    }
+  }
+
+ private:
+  std::int64_t node_of(std::int64_t ix, std::int64_t iy, std::int64_t iz) const {
+    return iz + nz_ * (ix + nx_ * iy);
+  }
+  double* plane_of(std::int64_t iz) const { return planes_ + (iz & 1) * 3 * plane_; }
+  double* layer_of(std::int64_t cz) const { return coefficients_ + (cz & 1) * 9 * layer_; }
+
+  std::int64_t nx_;
+  std::int64_t ny_;
+  std::int64_t nz_;
+  std::int64_t row_cells_;  // cells along x
+  std::int64_t layer_;      // cells per layer
+  std::int64_t plane_;      // nodes per plane
+  double* planes_;
+  double* coefficients_;
+  double* energy_;
+  double* rounding_;
+  double* gx_;
+  double* gy_;
+  double* gz_;
+};
+
+}  // namespace
+
 // Every cell's gradient coefficients (eqs. 4.66-4.69, elastic::cell_value) are computed once
 // and gathered by its eight vertices in CellStencil::gather's order, and the energy is summed
 // in the blocks of detail::fixed_order_sums: bitwise the results of a pass over all cells into
@@ -475,11 +689,8 @@ ElasticValue VolumeKernel::evaluate(const lattice::Lattice& lat, const Eigen::Ma
 // and gathers plane iz once layer iz is done. It owns the planes whose first cell lies in its
 // blocks (the last thread also the top plane, which starts no layer); it first computes the
 // layer below its first plane, and its last layer may reach into the next thread's blocks; the
-// energy counts only its own blocks.
-// The work runs along x, one SIMD lane per cell or node (cell_rows.hpp): the two node planes
-// of a layer are copied x fastest into three component arrays, the layer buffers hold each of
-// the nine coefficients as an array over the layer's cells, and a node row gathers its cells
-// one vertex offset at a time in the stencil's order, which every lane keeps.
+// energy counts only its own blocks. The work runs along x, one SIMD lane per cell or node
+// (cell_rows.hpp, CellLayers).
 ElasticValue VolumeKernel::evaluate_with_gradient(const lattice::Lattice& lat,
                                                   const Eigen::Matrix3Xd& x, double force_factor,
                                                   Eigen::Matrix3Xd& gradient) const {
@@ -487,19 +698,13 @@ ElasticValue VolumeKernel::evaluate_with_gradient(const lattice::Lattice& lat,
   if (cells == 0) return {0.0, 0.0};
   const double kappa = lat.polymer.kappa;
   const double v0 = std::pow(lat.element_length, 3);
-  const int nx = lat.shape.nx();
-  const int ny = lat.shape.ny();
-  const int nz = lat.shape.nz();
-  const std::int64_t row_cells = nx - 1;             // cells along x
-  const std::int64_t layer = row_cells * (ny - 1);   // cells per layer
-  const std::int64_t plane = std::int64_t{nx} * ny;  // nodes per plane
-  const std::int64_t layers = cells / layer;         // nz - 1
+  const std::int64_t nz = lat.shape.nz();
+  const std::int64_t layer = std::int64_t{lat.shape.nx() - 1} * (lat.shape.ny() - 1);
+  const std::int64_t layers = cells / layer;  // nz - 1
   std::vector<std::array<double, 2>> partial = block_partials(cells);
   const bool parallel = cells >= detail::kParallelMinimum;
   const std::int64_t max_threads = parallel ? omp_get_max_threads() : 1;
-  // Per thread: two node planes (3 components each), two coefficient layers (9 arrays each),
-  // one cell row's energies and roundings, one node row's gradients.
-  const std::int64_t scratch_per_thread = 2 * 3 * plane + 2 * 9 * layer + 2 * row_cells + 3 * nx;
+  const std::int64_t scratch_per_thread = CellLayers::scratch_size(lat.shape);
   layer_buffers_.resize(static_cast<std::size_t>(max_threads * scratch_per_thread));
 
 #pragma omp parallel if (parallel)
@@ -515,84 +720,16 @@ ElasticValue VolumeKernel::evaluate_with_gradient(const lattice::Lattice& lat,
         std::max<std::int64_t>(0, std::min(plane_begin - 1, own.begin / layer));
     const std::int64_t layer_end =
         std::min(layers, std::max(plane_end, own.end > own.begin ? (own.end - 1) / layer + 1 : 0));
-    double* const planes = layer_buffers_.data() + thread * scratch_per_thread;
-    double* const coefficients = planes + 2 * 3 * plane;
-    double* const energy = coefficients + 2 * 9 * layer;
-    double* const rounding = energy + row_cells;
-    double* const gx = rounding + row_cells;
-    double* const gy = gx + nx;
-    double* const gz = gy + nx;
-    const auto plane_of = [&](std::int64_t iz) { return planes + (iz & 1) * 3 * plane; };
-    const auto layer_of = [&](std::int64_t cz) { return coefficients + (cz & 1) * 9 * layer; };
-    const auto node_of = [&](std::int64_t ix, std::int64_t iy, std::int64_t iz) {
-      return iz + nz * (ix + nx * iy);
-    };
-    const auto load_plane = [&](std::int64_t iz) {
-      double* p = plane_of(iz);
-      for (std::int64_t iy = 0; iy < ny; ++iy) {
-        for (std::int64_t ix = 0; ix < nx; ++ix, ++p) {
-          const std::int64_t n = node_of(ix, iy, iz);
-          p[0] = x(0, n);
-          p[plane] = x(1, n);
-          p[2 * plane] = x(2, n);
-        }
-      }
-    };
+    CellLayers buffers(lat.shape, layer_buffers_.data() + thread * scratch_per_thread);
     OwnBlockSums sums(own, partial);
-    const auto gather_plane = [&](std::int64_t iz) {
-      for (std::int64_t iy = 0; iy < ny; ++iy) {
-        for (std::int64_t ix = 0; ix < nx; ++ix) {
-          const std::int64_t n = node_of(ix, iy, iz);
-          gx[ix] = gradient(0, n);
-          gy[ix] = gradient(1, n);
-          gz[ix] = gradient(2, n);
-        }
-        for (const auto& [dx, dy, dz] : kCellsOfNode) {  // cell (ix - dx, iy - dy, iz - dz)
-          const std::int64_t cy = iy - dy;
-          const std::int64_t cz = iz - dz;
-          if (cy < 0 || cy >= ny - 1 || cz < 0 || cz >= layers) continue;
-          const double* const row = layer_of(cz) + row_cells * cy;
-          cell_rows::Coefficients<const double*> t{};
-          for (std::size_t k = 0; k < 9; ++k) t[k] = row + static_cast<std::int64_t>(k) * layer;
-          // The node is local vertex 2 dx + 4 dy + dz: signs s_a, s_b, s_c by dx, dy, dz.
-          cell_rows::add_vertex_gradient(row_cells, t, dx == 1 ? 1.0 : -1.0, dy == 1 ? 1.0 : -1.0,
-                                         dz == 1 ? 1.0 : -1.0, gx + dx, gy + dx, gz + dx);
-        }
-        for (std::int64_t ix = 0; ix < nx; ++ix) {
-          const std::int64_t n = node_of(ix, iy, iz);
-          gradient(0, n) = gx[ix];
-          gradient(1, n) = gy[ix];
-          gradient(2, n) = gz[ix];
-        }
-      }
-    };
-    if (layer_begin < layer_end) load_plane(layer_begin);
+    if (layer_begin < layer_end) buffers.load_plane(x, layer_begin);
     for (std::int64_t cz = layer_begin; cz < layer_end; ++cz) {
-      load_plane(cz + 1);
-      for (std::int64_t cy = 0; cy < ny - 1; ++cy) {
-        cell_rows::Corners corners{};
-        for (std::size_t v = 0; v < 8; ++v) {  // local vertex v = 2 dx + 4 dy + dz
-          const std::int64_t dx = (v >> 1U) & 1U;
-          const std::int64_t dy = (v >> 2U) & 1U;
-          const std::int64_t dz = v & 1U;
-          const double* p = plane_of(cz + dz) + nx * (cy + dy) + dx;
-          corners.x[v] = p;
-          corners.y[v] = p + plane;
-          corners.z[v] = p + 2 * plane;
-        }
-        cell_rows::Coefficients<double*> t{};
-        double* const row = layer_of(cz) + row_cells * cy;
-        for (std::size_t k = 0; k < 9; ++k) t[k] = row + static_cast<std::int64_t>(k) * layer;
-        cell_rows::coefficients(row_cells, corners, kappa, v0, force_factor, t, energy, rounding);
-        const std::int64_t first_cell = cz * layer + row_cells * cy;
-        for (std::int64_t i = 0; i < row_cells; ++i) {
-          sums.add(first_cell + i, energy[i], rounding[i]);
-        }
-      }
-      if (cz >= plane_begin && cz < plane_end) gather_plane(cz);
+      buffers.load_plane(x, cz + 1);
+      buffers.compute_layer(cz, kappa, v0, force_factor, sums);
+      if (cz >= plane_begin && cz < plane_end) buffers.gather_plane(cz, gradient);
     }
     // The top plane holds cells of the last layer only.
-    if (plane_end == nz && plane_begin <= nz - 1) gather_plane(nz - 1);
+    if (plane_end == nz && plane_begin <= nz - 1) buffers.gather_plane(nz - 1, gradient);
   }
   return total_of(partial);
 }
