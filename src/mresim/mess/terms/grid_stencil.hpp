@@ -64,9 +64,6 @@ class SpringStencil {
   std::int64_t first_spring(std::int64_t node) const {
     return node < node_count() ? first_spring_[static_cast<std::size_t>(node)] : spring_count_;
   }
-  // The largest node index step of a spring (the offset (+x, +y, +z)): a node's backward
-  // springs all come from the nodes at most this far below it.
-  std::int64_t max_delta() const { return *std::max_element(delta_.begin(), delta_.end()); }
   // The node index change of each forward offset, and the offsets by decreasing change (the
   // order of a node's backward springs).
   const std::array<std::int64_t, 13>& deltas() const { return delta_; }
