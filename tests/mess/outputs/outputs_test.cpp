@@ -42,6 +42,10 @@ TEST(MessOutputs, ResultsSummaryAndXdmfAreConsistent) {
   // Physical profile, L-BFGS without a fallback: L-BFGS finished every step, no seed passes.
   EXPECT_EQ(h5.strings("/steps/solver/finished_by"), std::vector<std::string>(steps, "lbfgs"));
   EXPECT_EQ(h5.ints("/steps/solver/correction_passes"), std::vector<std::int64_t>(steps, 0));
+  // A field loop: the first step from the lattice, each later one from the step before.
+  std::vector<std::string> start(steps, "previous");
+  start[0] = "initial_lattice";
+  EXPECT_EQ(h5.strings("/steps/solver/start"), start);
   // The measured peak memory of the run, absolute and per node: the
   // process held at least its lattice (positions alone are 24 bytes per node).
   const auto peak = static_cast<double>(

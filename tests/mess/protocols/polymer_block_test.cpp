@@ -91,10 +91,12 @@ TEST(MessPolymerBlock, ShearGivesThePolymersShearModulusAndNoMrEffect) {
     EXPECT_NEAR(modulus[f], affine.modulus, 1e-7 * kShearModulus) << "field " << f;
     EXPECT_NEAR(modulus[f] / kShearModulus - 1.0, 0.0, 2e-4) << "field " << f;
   }
-  // No particles: the field acts on nothing, so every field gives the same modulus and the MR
-  // effect is 0, exactly (the same relaxations, bit for bit).
+  // No particles: the field acts on nothing, so every field relaxes the same problem and the MR
+  // effect is 0 to rounding. (Not bit for bit: the later fields' first strain starts from the
+  // previous field's response, solver.load_step_start, the same state up to rounding;
+  // measured 9e-14.)
   const auto mr = h5.doubles("/analysis/mr_effect");
-  for (std::size_t f = 0; f < mr.size(); ++f) EXPECT_EQ(mr[f], 0.0) << "field " << f;
+  for (std::size_t f = 0; f < mr.size(); ++f) EXPECT_NEAR(mr[f], 0.0, 1e-9) << "field " << f;
   EXPECT_EQ(h5.ints("/analysis/mr_effect_valid"), (std::vector<std::int64_t>{1, 1, 1}));
   EXPECT_EQ(h5.ints("/analysis/valid"), (std::vector<std::int64_t>{1, 1, 1}));
 }

@@ -245,6 +245,13 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"LeapfrogSettingsWithTheMinimiser", kValid + "[solver.leapfrog]\ndt = 4e-3\n",
                  "solver.leapfrog = {...}: only read with solver.method = \"leapfrog\" (the method "
                  "is \"minimiser\")"},
+        BadInput{"LoadStepStartInAHysteresisRun",
+                 kValid + "[solver]\nload_step_start = \"previous\"\n",
+                 "solver.load_step_start = \"previous\": only read with run.type = "
+                 "\"mess_strain\" (the runs whose load steps start from the previous load "
+                 "value)"},
+        BadInput{"UnknownLoadStepStart", kStrain + "[solver]\nload_step_start = \"predicted\"\n",
+                 "solver.load_step_start = \"predicted\": must be one of extrapolated, previous"},
         BadInput{"NegativeMagnetizationTolerance",
                  kValid + "[solver.magnetization]\natol = -1e-3\n",
                  "solver.magnetization.atol = -0.001: must be >= 1e-15 (Ms)"},

@@ -117,6 +117,10 @@ void write_step_records(io::Hdf5File& file, const std::string& group,
   finished_by.reserve(records.size());
   for (const StepRecord& r : records) finished_by.push_back(r.finished_by);
   file.write_string_vector(s + "finished_by", finished_by);
+  std::vector<std::string> start;
+  start.reserve(records.size());
+  for (const StepRecord& r : records) start.push_back(r.start);
+  file.write_string_vector(s + "start", start);
   file.write_int_vector(s + "correction_passes",
                         int_column(records, [](auto& r) { return r.correction_passes; }));
   file.write_vector(s + "max_force", column(records, [](auto& r) { return r.max_force; }), "N");
@@ -188,6 +192,10 @@ std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std:
   const std::vector<std::string> finished_by = file.exists(s + "finished_by")
                                                    ? file.strings(s + "finished_by")
                                                    : std::vector<std::string>(n, "unrecorded");
+  // Absent in files written before the start was recorded: "unrecorded".
+  const std::vector<std::string> start = file.exists(s + "start")
+                                             ? file.strings(s + "start")
+                                             : std::vector<std::string>(n, "unrecorded");
   const std::vector<std::int64_t> passes = file.exists(s + "correction_passes")
                                                ? ints(s + "correction_passes")
                                                : std::vector<std::int64_t>(n, 0);
@@ -202,7 +210,7 @@ std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std:
   const std::vector<std::int64_t> peak_memory = file.exists(s + "peak_resident_memory")
                                                     ? ints(s + "peak_resident_memory")
                                                     : std::vector<std::int64_t>(n, 0);
-  if (status.size() != n || method.size() != n || finished_by.size() != n) {
+  if (status.size() != n || method.size() != n || finished_by.size() != n || start.size() != n) {
     throw std::runtime_error("inconsistent solver data in " + group);
   }
   const auto np = static_cast<Eigen::Index>(particle_count);
@@ -220,6 +228,7 @@ std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std:
     r.evaluations = evaluations[i];
     r.krylov_iterations = krylov[i];
     r.finished_by = finished_by[i];
+    r.start = start[i];
     r.correction_passes = passes[i];
     r.max_force = max_force[i];
     r.magnetization_solves = solves[i];

@@ -9,6 +9,7 @@
 #include "mresim/core/constants.hpp"
 #include "mresim/mess/analysis/box_strain.hpp"
 #include "mresim/mess/lattice/volume_elements.hpp"
+#include "mresim/mess/protocols/load_step_start.hpp"
 #include "mresim/mess/protocols/protocol.hpp"
 #include "mresim/mess/solvers/leapfrog.hpp"
 #include "mresim/mess/solvers/minimiser.hpp"
@@ -128,6 +129,60 @@ void ProtocolRunner::set_start(const StepSpec& step, ProtocolState& state) {
   }
 }
 
+const StepSpec& ProtocolRunner::step_at(std::size_t field_index, std::size_t load_index) const {
+  for (const StepSpec& s : steps_) {
+    if (s.field_index == field_index && s.load_index == load_index) return s;
+  }
+  throw std::logic_error("ProtocolRunner: no step at field " + std::to_string(field_index) +
+                         " and load value " + std::to_string(load_index));
+}
+
+std::string ProtocolRunner::predict_start(const StepSpec& step, const ProtocolState& state,
+                                          std::int64_t& evaluations) {
+  if (start_state(step, state) == nullptr) return step_start::kInitialLattice;
+  const Protocol& protocol = *spec_.protocol;
+  const bool first_field = step.field_index == 0;
+  if (spec_.solver.load_step_start != mc::LoadStepStart::extrapolated || step.load_index == 0 ||
+      !protocol.loads_from_zero_load_state() || (step.load_index == 1 && first_field)) {
+    return step_start::kPrevious;
+  }
+  const lattice::Lattice& lat = system_.lattice();
+  const Eigen::Matrix3Xd zero_load = state.references[step.field_index].load();
+  Eigen::Matrix3Xd candidate;
+  std::string kind;
+  if (step.load_index >= 2) {
+    const StepSpec& previous = step_at(step.field_index, step.load_index - 1);
+    const StepSpec& zero = step_at(step.field_index, 0);
+    const Eigen::Matrix3Xd& x = system_.positions();
+    candidate = secant_start(x, zero_load, protocol.measured_strain(lat, step, x, zero_load),
+                             protocol.measured_strain(lat, previous, x, zero_load),
+                             protocol.measured_strain(lat, zero, zero_load, zero_load));
+    kind = step_start::kSecant;
+  } else {
+    // Load value 1: the previous field has just relaxed it (its slot) from its reference.
+    const std::size_t neighbour = step.field_index - 1;
+    candidate =
+        neighbour_field_start(zero_load, state.slots[slot_of_field(neighbour)].positions.load(),
+                              state.references[neighbour].load());
+    kind = step_start::kNeighbourField;
+  }
+  // Keep the start with the lower potential, both with this step's faces and field; M is solved
+  // at each (evaluate), and set back to the previous state's where that start stays.
+  const Eigen::Matrix3Xd magnetization = system_.magnetizations();
+  const double previous_potential = system_.evaluate(nullptr).potential;
+  system_.set_magnetizations(magnetization);
+  std::swap(system_.mutable_positions(), candidate);
+  system_.apply_constraints();
+  const double predicted_potential = system_.evaluate(nullptr).potential;
+  evaluations += 2;
+  if (std::isfinite(predicted_potential) && predicted_potential <= previous_potential) {
+    return kind;
+  }
+  std::swap(system_.mutable_positions(), candidate);
+  system_.set_magnetizations(magnetization);
+  return step_start::kPredictionRejected;
+}
+
 const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   if (state.next_step >= steps_.size()) {
     throw std::logic_error("ProtocolRunner::run_next_step: no steps left");
@@ -154,13 +209,15 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   const mess::MagnetizationStats before = system_.magnetization_stats();
   StepRecord record;
   record.step = step;
+  std::int64_t prediction_evaluations = 0;
+  record.start = predict_start(step, state, prediction_evaluations);
   const double b = step.field.norm();
   if (spec_.solver.method != mc::SolverMethod::leapfrog) {
     const mess::MinimiserResult r = mess::minimise(system_, minimiser_options());
     record.converged = r.converged;
     record.status = to_string(r.status);
     record.iterations = r.iterations;
-    record.evaluations = r.evaluations;
+    record.evaluations = r.evaluations + prediction_evaluations;
     record.krylov_iterations = r.krylov_iterations;
     record.finished_by = finished_by_name(r, spec_.solver.method == mc::SolverMethod::newton);
     record.correction_passes = r.correction_passes;
@@ -179,7 +236,7 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
     record.converged = r.converged;
     record.status = to_string(r.status);
     record.iterations = r.steps;
-    record.evaluations = r.steps + 1;
+    record.evaluations = r.steps + 1 + prediction_evaluations;
     record.finished_by = "leapfrog";
     record.max_force = r.history.empty() ? 0.0 : r.history.back().mean_abs_acceleration;
     record.energies = r.final.energies;

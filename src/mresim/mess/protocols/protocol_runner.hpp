@@ -11,6 +11,9 @@
 //    magnetization history;
 //  - later load values: from the result of the previous load value at the same field (the
 //    original's output n - (F - 1)). Unlike the original this also holds with a single field.
+//    Strain runs with solver.load_step_start = "extrapolated" (the default) move that state to a
+//    prediction of the new one first (load_step_start.hpp); the relaxation ends at the same
+//    tolerance.
 // The zero-load result at each field is the reference configuration of the loaded steps at that
 // field (strain values are applied relative to it; a stress run's strain is measured from it).
 //
@@ -64,6 +67,9 @@ struct StepRecord {
   // took over, so that a slow step can be traced to FIRE or the slope-only search.
   std::string finished_by;
   std::int64_t correction_passes = 0;  // seed profile, L-BFGS: correction passes for its forces
+  // Where the relaxation started (load_step_start.hpp, step_start::): "initial_lattice",
+  // "previous", "secant", "neighbour_field", "previous_prediction_rejected".
+  std::string start;
   double max_force = 0.0;  // N (minimiser); leapfrog: mean |a| of its last round, scaled
   std::int64_t magnetization_solves = 0;
   std::int64_t unconverged_magnetization_solves = 0;
@@ -141,6 +147,14 @@ class ProtocolRunner {
   // Puts the step's start (start_state: positions and magnetizations; the initial lattice
   // without one) into the system, then parks the kept positions.
   void set_start(const StepSpec& step, ProtocolState& state);
+  // Strain runs with solver.load_step_start = "extrapolated": replaces the start of a loaded
+  // step by its prediction (load_step_start.hpp) where that has no higher potential. Call with
+  // the step's field and boundary set. Returns how the step starts (step_start::); adds the
+  // evaluations it made to `evaluations`.
+  // The planned step at this field and load value; std::logic_error if there is none.
+  const StepSpec& step_at(std::size_t field_index, std::size_t load_index) const;
+  std::string predict_start(const StepSpec& step, const ProtocolState& state,
+                            std::int64_t& evaluations);
   // The run file's solver settings for one relaxation, with the run's caches.
   mess::MinimiserOptions minimiser_options() const;
 

@@ -269,6 +269,13 @@ void describe_solver(const MessSpec& s, app::InfoReport& r) {
     r.add_integer(sec, "max_rounds", v.leapfrog.max_rounds);
     r.add(sec, "drag", v.leapfrog.drag, "1/t_c");
   }
+  if (s.protocol->loads_from_zero_load_state()) {
+    const bool extrapolated = v.load_step_start == LoadStepStart::extrapolated;
+    r.add_text(sec, "load_step_start", extrapolated ? "extrapolated" : "previous",
+               extrapolated ? "each strain starts from a prediction (the secant through the "
+                              "zero-strain state, or the previous field's response)"
+                            : "each strain starts from the previous one's state (the original)");
+  }
   const magnetism::MagnetizationOptions& m = v.magnetization;
   const std::string tolerance = magnetization_tolerance_name(m);
   r.add_text(sec, "magnetization_tolerance", tolerance,

@@ -152,8 +152,15 @@ struct LeapfrogSettings {
 // where it is not known. The reader refuses leapfrog.dt at or above it (seed profile only).
 std::optional<double> leapfrog_stability_limit(int discretization_order);
 
+// Where a loaded step of a strain run starts (protocols/load_step_start.hpp): from a
+// prediction (the secant through the zero-strain state, or the previous field's response), or
+// from the previous load value's state as it is (the original code).
+enum class LoadStepStart { extrapolated, previous };
+
 struct SolverSpec {
   SolverMethod method = SolverMethod::minimiser;
+  // Default: extrapolated, except with the leapfrog (which reproduces the original: previous).
+  LoadStepStart load_step_start = LoadStepStart::extrapolated;
   MinimiserSettings minimiser;
   LeapfrogSettings leapfrog;
   // atol, rtol, iteration budgets; `demagnetization` mirrors MessSpec::demagnetization.

@@ -527,7 +527,10 @@ void read_field(const TableReader& root, FieldSequence default_sequence, FieldSp
 
 constexpr double kMinMagnetizationAtol = 1e-15;  // Ms
 
-void read_solver(const std::optional<TableReader>& solver, bool demagnetization, SolverSpec& s) {
+// `loads_from_zero_load`: the run's protocol measures its load steps from the zero-load state
+// (strain runs), the only ones whose start solver.load_step_start chooses.
+void read_solver(const std::optional<TableReader>& solver, bool demagnetization,
+                 bool loads_from_zero_load, SolverSpec& s) {
   s.magnetization.demagnetization = demagnetization;
   if (!solver) return;
   const TableReader& t = *solver;
@@ -537,6 +540,17 @@ void read_solver(const std::optional<TableReader>& solver, bool demagnetization,
              : method == "newton" ? SolverMethod::newton
              : method == "lbfgs"  ? SolverMethod::lbfgs
                                   : SolverMethod::minimiser;
+  // The leapfrog reproduces the original code, which starts each strain from the previous one.
+  const LoadStepStart start_default =
+      s.method == SolverMethod::leapfrog ? LoadStepStart::previous : LoadStepStart::extrapolated;
+  if (t.has("load_step_start") && !loads_from_zero_load) {
+    t.fail("load_step_start", t.value_text("load_step_start"),
+           "only read with run.type = \"mess_strain\" (the runs whose load steps start from the "
+           "previous load value)");
+  }
+  s.load_step_start = t.enumeration_or(
+      "load_step_start", start_default,
+      {{"extrapolated", LoadStepStart::extrapolated}, {"previous", LoadStepStart::previous}});
   // [solver.minimiser] holds the criteria of lbfgs and newton alike.
   const std::string other = method == "leapfrog" ? "minimiser" : "leapfrog";
   if (t.has(other)) {
@@ -806,7 +820,8 @@ MessSpec read_mess_spec(const TableReader& root, std::string_view run_type) {
   // The optional energy terms' tables [terms.<name>] (terms/energy_term.hpp).
   s.terms = mess::read_term_tables(root);
 
-  read_solver(root.optional_table("solver"), s.demagnetization, s.solver);
+  read_solver(root.optional_table("solver"), s.demagnetization,
+              s.protocol->loads_from_zero_load_state(), s.solver);
   check_scales(root, s);
   check_leapfrog(root.optional_table("solver"), s);
   if (const auto t = root.optional_table("output")) {

@@ -1,0 +1,45 @@
+#include "mresim/mess/protocols/load_step_start.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <stdexcept>
+
+namespace mresim::mess_protocol {
+namespace {
+
+void check_same_size(const char* function, const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b,
+                     const char* a_name, const char* b_name) {
+  if (a.cols() != b.cols()) {
+    throw std::invalid_argument(fmt::format("{}: {} has {} columns, {} has {}", function, a_name,
+                                            a.cols(), b_name, b.cols()));
+  }
+}
+
+}  // namespace
+
+Eigen::Matrix3Xd secant_start(const Eigen::Matrix3Xd& previous, const Eigen::Matrix3Xd& zero_load,
+                              double c, double c_previous, double c_zero) {
+  constexpr const char* kFn = "secant_start";
+  check_same_size(kFn, previous, zero_load, "previous", "zero_load");
+  if (!std::isfinite(c) || !std::isfinite(c_previous) || !std::isfinite(c_zero) ||
+      c_previous == c_zero) {
+    throw std::invalid_argument(
+        fmt::format("{}: strain coordinates c = {}, c_previous = {}, c_zero = {}: all must be "
+                    "finite and c_previous != c_zero",
+                    kFn, c, c_previous, c_zero));
+  }
+  const double ratio = (c - c_previous) / (c_previous - c_zero);
+  return previous + ratio * (previous - zero_load);
+}
+
+Eigen::Matrix3Xd neighbour_field_start(const Eigen::Matrix3Xd& zero_load,
+                                       const Eigen::Matrix3Xd& neighbour_loaded,
+                                       const Eigen::Matrix3Xd& neighbour_zero_load) {
+  constexpr const char* kFn = "neighbour_field_start";
+  check_same_size(kFn, zero_load, neighbour_loaded, "zero_load", "neighbour_loaded");
+  check_same_size(kFn, zero_load, neighbour_zero_load, "zero_load", "neighbour_zero_load");
+  return zero_load + (neighbour_loaded - neighbour_zero_load);
+}
+
+}  // namespace mresim::mess_protocol

@@ -1,0 +1,52 @@
+#pragma once
+
+// Where a loaded step of a strain run starts (run file: solver.load_step_start,
+// docs/run-files-3d.md; measured in docs/performance.md, "Strain steps from a predicted start").
+//
+// A strain run relaxes load value k at field f from the relaxed state at load value k - 1 and the
+// same field (protocol_runner.hpp), with the moved faces put at load value k. Started from that
+// state as it is ("previous", the original code's start), the polymer next to the moved faces
+// begins strained by the whole increment, and the minimiser's first hundreds of iterations carry
+// it into the box. "extrapolated" starts from a prediction of the new state instead, in the
+// strain coordinate c in which the moved faces move linearly (Protocol::measured_strain: tan
+// gamma for shear, the engineering strain, the twist angle):
+//
+//  - k >= 2: the secant through the zero-strain state x_0 at the same field,
+//        x = x_{k-1} + (c_k - c_{k-1}) / (c_{k-1} - c_0) (x_{k-1} - x_0),
+//    exact where the response is linear in c (secant_start);
+//  - k = 1 at a field f >= 1: the zero-strain state plus the previous field's response at the
+//    same strain, x = x_0(f) + (x_1(f - 1) - x_0(f - 1)) (neighbour_field_start);
+//  - k = 1 at the first field: the previous state (nothing to extrapolate from).
+//
+// The prediction is only where the relaxation starts; it ends at the same tolerance. The runner
+// keeps it only where its potential is not above that of the previous state with the new faces:
+// after a jump (a particle joining a cluster) the secant would carry the jump on and push
+// particles into each other, and such a step starts as before.
+
+#include <Eigen/Core>
+#include <string>
+
+namespace mresim::mess_protocol {
+
+// How a step's relaxation started (StepRecord::start, /steps/solver/start in results.h5).
+namespace step_start {
+inline const std::string kInitialLattice = "initial_lattice";  // the run's first step
+inline const std::string kPrevious = "previous";  // the state the protocol prescribes, as it is
+inline const std::string kSecant = "secant";
+inline const std::string kNeighbourField = "neighbour_field";
+// A prediction was made and rejected (its potential was higher): started as "previous".
+inline const std::string kPredictionRejected = "previous_prediction_rejected";
+}  // namespace step_start
+
+// x_{k-1} + (c - c_previous) / (c_previous - c_zero) (x_{k-1} - x_0). Throws
+// std::invalid_argument if the arrays differ in size, a coordinate is not finite or c_previous ==
+// c_zero.
+Eigen::Matrix3Xd secant_start(const Eigen::Matrix3Xd& previous, const Eigen::Matrix3Xd& zero_load,
+                              double c, double c_previous, double c_zero);
+
+// x_0(f) + (x_1(f - 1) - x_0(f - 1)). Throws std::invalid_argument if the arrays differ in size.
+Eigen::Matrix3Xd neighbour_field_start(const Eigen::Matrix3Xd& zero_load,
+                                       const Eigen::Matrix3Xd& neighbour_loaded,
+                                       const Eigen::Matrix3Xd& neighbour_zero_load);
+
+}  // namespace mresim::mess_protocol

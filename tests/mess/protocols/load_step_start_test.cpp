@@ -1,0 +1,152 @@
+// Where a strain run's loaded steps start (protocols/load_step_start.hpp): the predictions'
+// formulas, and on a small shear run that the predicted starts reach the same states as the
+// original's start in fewer iterations, are recorded per step, and resume bit for bit.
+
+#include "mresim/mess/protocols/load_step_start.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "../../support/temp_dir.hpp"
+#include "../support/small_runs.hpp"
+#include "mresim/mess/outputs/checkpoint.hpp"
+#include "mresim/mess/protocols/protocol_runner.hpp"
+
+namespace mresim::mess_protocol {
+namespace {
+
+using testing::spec_of;
+
+Eigen::Matrix3Xd linear_state(const Eigen::Matrix3Xd& zero, const Eigen::Matrix3Xd& slope,
+                              double c) {
+  return zero + c * slope;
+}
+
+TEST(LoadStepStart, SecantIsExactForALinearResponse) {
+  const Eigen::Matrix3Xd zero = Eigen::Matrix3Xd::Random(3, 50);
+  const Eigen::Matrix3Xd slope = Eigen::Matrix3Xd::Random(3, 50);
+  // Unevenly spaced strain coordinates, c_0 != 0 (e.g. a shifted measure).
+  const double c0 = 0.1;
+  const double c1 = 0.35;
+  const double c2 = 0.5;
+  const Eigen::Matrix3Xd predicted =
+      secant_start(linear_state(zero, slope, c1), linear_state(zero, slope, c0), c2, c1, c0);
+  EXPECT_LT((predicted - linear_state(zero, slope, c2)).cwiseAbs().maxCoeff(), 1e-14);
+}
+
+TEST(LoadStepStart, SecantOfAQuadraticResponseMissesByItsCurvature) {
+  // x(c) = x0 + c d + c^2 e from c0 = 0: the secant through 0 and c1 predicts c2 with the error
+  // c2 (c2 - c1) e, which the prediction must show (it is not the state itself).
+  const Eigen::Matrix3Xd x0 = Eigen::Matrix3Xd::Random(3, 7);
+  const Eigen::Matrix3Xd d = Eigen::Matrix3Xd::Random(3, 7);
+  const Eigen::Matrix3Xd e = Eigen::Matrix3Xd::Random(3, 7);
+  const auto x = [&](double c) -> Eigen::Matrix3Xd { return x0 + c * d + c * c * e; };
+  const Eigen::Matrix3Xd predicted = secant_start(x(0.02), x(0.0), 0.03, 0.02, 0.0);
+  const Eigen::Matrix3Xd expected_error = 0.03 * (0.03 - 0.02) * e;
+  EXPECT_LT(((x(0.03) - predicted) - expected_error).cwiseAbs().maxCoeff(), 1e-15);
+}
+
+TEST(LoadStepStart, NeighbourFieldAddsItsResponseToTheZeroLoadState) {
+  const Eigen::Matrix3Xd zero = Eigen::Matrix3Xd::Random(3, 9);
+  const Eigen::Matrix3Xd neighbour_zero = Eigen::Matrix3Xd::Random(3, 9);
+  const Eigen::Matrix3Xd response = Eigen::Matrix3Xd::Random(3, 9);
+  const Eigen::Matrix3Xd predicted =
+      neighbour_field_start(zero, neighbour_zero + response, neighbour_zero);
+  EXPECT_LT((predicted - (zero + response)).cwiseAbs().maxCoeff(), 1e-15);
+}
+
+TEST(LoadStepStart, RefusesMismatchedArraysAndDegenerateCoordinates) {
+  const Eigen::Matrix3Xd a = Eigen::Matrix3Xd::Zero(3, 4);
+  const Eigen::Matrix3Xd b = Eigen::Matrix3Xd::Zero(3, 5);
+  EXPECT_THROW((void)secant_start(a, b, 0.2, 0.1, 0.0), std::invalid_argument);
+  EXPECT_THROW((void)secant_start(a, a, 0.2, 0.1, 0.1), std::invalid_argument);
+  EXPECT_THROW((void)secant_start(a, a, std::numeric_limits<double>::quiet_NaN(), 0.1, 0.0),
+               std::invalid_argument);
+  EXPECT_THROW((void)neighbour_field_start(a, b, a), std::invalid_argument);
+  EXPECT_THROW((void)neighbour_field_start(a, a, b), std::invalid_argument);
+}
+
+// The small pair (support/small_runs.hpp) sheared at two fields through four strains.
+std::string small_shear(const std::string& start) {
+  return std::string("[run]\ntype = \"mess_strain\"\n") + testing::kSmallModel +
+         "\n[field]\nmagnitudes = [0.0, 0.05]\n"
+         "\n[strain]\nkind = \"shear\"\nnormal = \"z\"\ndirection = \"x\"\n"
+         "max = 0.02\nsteps = 4\n" +
+         (start.empty() ? "" : "\n[solver]\nload_step_start = \"" + start + "\"\n");
+}
+
+std::vector<StepRecord> run_all(const std::string& toml) {
+  ProtocolRunner runner(spec_of(toml));
+  ProtocolState state = runner.initial_state();
+  runner.run(state, nullptr);
+  return state.records;
+}
+
+TEST(LoadStepStart, PredictedStartsReachTheOriginalsStatesInFewerIterations) {
+  const std::vector<StepRecord> previous = run_all(small_shear("previous"));
+  const std::vector<StepRecord> predicted = run_all(small_shear(""));  // the default
+  ASSERT_EQ(previous.size(), 10U);
+  ASSERT_EQ(predicted.size(), previous.size());
+
+  // Step n = k F + f (F = 2): the first step from the lattice; the zero strains and the first
+  // strain at the first field from the previous state; the first strain at the second field
+  // from the first field's response; later strains on the secant.
+  const std::vector<std::string> expected_start = {
+      step_start::kInitialLattice, step_start::kPrevious, step_start::kPrevious,
+      step_start::kNeighbourField, step_start::kSecant,   step_start::kSecant,
+      step_start::kSecant,         step_start::kSecant,   step_start::kSecant,
+      step_start::kSecant};
+  std::int64_t iterations_previous = 0;
+  std::int64_t iterations_predicted = 0;
+  const double l_e = 1e-6;  // n_d = 1, R = 1.5 um
+  for (std::size_t i = 0; i < previous.size(); ++i) {
+    const StepRecord& a = previous[i];
+    const StepRecord& b = predicted[i];
+    EXPECT_EQ(a.start, i == 0 ? step_start::kInitialLattice : step_start::kPrevious);
+    EXPECT_EQ(b.start, expected_start[i]) << "step " << i;
+    EXPECT_TRUE(a.converged && b.converged) << "step " << i;
+    // The same minimum to well within the force tolerance's reach (1e-6 k_eff l_e).
+    EXPECT_LT((a.centres - b.centres).cwiseAbs().maxCoeff(), 1e-6 * l_e) << "step " << i;
+    EXPECT_LT((a.magnetization - b.magnetization).cwiseAbs().maxCoeff(), 1e-6 * 1.6e6)
+        << "step " << i;
+    EXPECT_NEAR(a.energies.total(), b.energies.total(), 1e-6 * std::abs(a.energies.total()))
+        << "step " << i;
+    iterations_previous += a.iterations;
+    iterations_predicted += b.iterations;
+  }
+  EXPECT_LT(iterations_predicted, iterations_previous);
+}
+
+TEST(LoadStepStart, ResumedFromACheckpointEqualsTheUninterruptedRun) {
+  const std::string toml = small_shear("");
+  const mess_config::MessSpec spec = spec_of(toml);
+  const std::vector<StepRecord> full = run_all(toml);
+
+  const mresim::testing::TempDir dir;
+  const auto checkpoint = dir / "checkpoint.h5";
+  {
+    ProtocolRunner first(spec);
+    ProtocolState partial = first.initial_state();
+    // Stops before the neighbour-field step 3 and the secant steps after it.
+    for (int i = 0; i < 3; ++i) first.run_next_step(partial);
+    write_checkpoint(checkpoint, partial, first, toml, "test.toml");
+  }
+  ProtocolRunner second(spec);
+  ProtocolState resumed = read_checkpoint(checkpoint, second, toml);
+  second.run(resumed, nullptr);
+  ASSERT_EQ(resumed.records.size(), full.size());
+  for (std::size_t i = 0; i < full.size(); ++i) {
+    EXPECT_EQ(resumed.records[i].start, full[i].start) << "step " << i;
+    EXPECT_EQ(resumed.records[i].centres, full[i].centres) << "step " << i;
+    EXPECT_EQ(resumed.records[i].energies.total(), full[i].energies.total()) << "step " << i;
+    EXPECT_EQ(resumed.records[i].iterations, full[i].iterations) << "step " << i;
+  }
+}
+
+}  // namespace
+}  // namespace mresim::mess_protocol
