@@ -107,8 +107,9 @@ int main(int argc, char** argv) {
     if (a.cpu < previous.cpu) previous = std::move(a);
     if (b.cpu < extrapolated.cpu) extrapolated = std::move(b);
   }
-  std::printf("Fig. 4.14 shear (small), n_d = %d: %lld nodes, 3 fields x %d strain steps to 0.1 rad\n",
-              order, static_cast<long long>(previous.nodes), steps);
+  std::printf(
+      "Fig. 4.14 shear (small), n_d = %d: %lld nodes, 3 fields x %d strain steps to 0.1 rad\n",
+      order, static_cast<long long>(previous.nodes), steps);
   for (const auto& [name, r] :
        {std::pair<const char*, const Run&>{"previous", previous}, {"extrapolated", extrapolated}}) {
     std::printf("  %-12s strained steps: %6lld iterations, %6lld evaluations, CPU %8.2f s\n", name,
