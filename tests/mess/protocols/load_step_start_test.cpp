@@ -13,13 +13,16 @@
 #include <vector>
 
 #include "../../support/temp_dir.hpp"
+#include "../support/mess_test_support.hpp"
 #include "../support/small_runs.hpp"
 #include "mresim/mess/outputs/checkpoint.hpp"
+#include "mresim/mess/profile/model_profile.hpp"
 #include "mresim/mess/protocols/protocol_runner.hpp"
 
 namespace mresim::mess_protocol {
 namespace {
 
+using mess::BoundaryConstraints;
 using testing::spec_of;
 
 Eigen::Matrix3Xd linear_state(const Eigen::Matrix3Xd& zero, const Eigen::Matrix3Xd& slope,
@@ -69,6 +72,58 @@ TEST(LoadStepStart, RefusesMismatchedArraysAndDegenerateCoordinates) {
                std::invalid_argument);
   EXPECT_THROW((void)neighbour_field_start(a, b, a), std::invalid_argument);
   EXPECT_THROW((void)neighbour_field_start(a, a, b), std::invalid_argument);
+}
+
+// Two n_d = 1 particles in a 6 x 6 x 10 cell box, faces held, 0.1 T along z, M solved once.
+mess::MessSystem guarded_system() {
+  const mess::ModelProfile& profile = mess::model_profile("physical");
+  mess::MessSystem system = mess::MessSystem::make(
+      mess::testing::small_lattice(profile, {6, 6, 10}, {{2, 2, 2}, {3, 3, 6}}),
+      mess::testing::tesla(0.0, 0.0, 0.1), profile);
+  BoundaryConstraints held = BoundaryConstraints::none(system.node_count());
+  for (const lattice::Face f : {lattice::Face::left, lattice::Face::right, lattice::Face::front,
+                                lattice::Face::back, lattice::Face::bottom, lattice::Face::top}) {
+    held.fix_face(system.lattice().shape, f, system.lattice().positions);
+  }
+  system.set_constraints(std::move(held));
+  (void)system.evaluate(nullptr);  // M solved: the history a step starts from
+  return system;
+}
+
+TEST(LoadStepStart, AHigherCandidateLeavesTheSystemAsItWas) {
+  mess::MessSystem system = guarded_system();
+  const Eigen::Matrix3Xd positions = system.positions();
+  const Eigen::Matrix3Xd magnetization = system.magnetizations();
+  // Every node moved by up to 0.3 l_e at random: the springs and cells strained.
+  Eigen::Matrix3Xd candidate =
+      positions + 0.3 * system.length_scale() * Eigen::Matrix3Xd::Random(3, positions.cols());
+  const Eigen::Matrix3Xd offered = candidate;
+  EXPECT_FALSE(take_if_not_higher(system, candidate));
+  EXPECT_EQ(system.positions(), positions);
+  EXPECT_EQ(system.magnetizations(), magnetization);
+  EXPECT_EQ(candidate.cols(), offered.cols());
+}
+
+TEST(LoadStepStart, ALowerCandidateIsTakenWithItsHeldCoordinatesFromTheConstraints) {
+  mess::MessSystem system = guarded_system();
+  const Eigen::Matrix3Xd rest = system.positions();
+  // The start: the rest lattice strained at random; the candidate: the rest lattice (lower),
+  // but with every node, held ones too, shifted by a tiny amount the constraints undo.
+  Eigen::Matrix3Xd start =
+      rest + 0.2 * system.length_scale() * Eigen::Matrix3Xd::Random(3, rest.cols());
+  system.set_positions(start);
+  Eigen::Matrix3Xd candidate = rest.array() + 1e-3 * system.length_scale();
+  EXPECT_TRUE(take_if_not_higher(system, candidate));
+  const mess::BoundaryConstraints& held = system.constraints();
+  for (Eigen::Index n = 0; n < rest.cols(); ++n) {
+    for (int a = 0; a < 3; ++a) {
+      const double expected =
+          held.is_fixed(n, a) ? rest(a, n) : rest(a, n) + 1e-3 * system.length_scale();
+      ASSERT_EQ(system.positions()(a, n), expected) << "node " << n << " axis " << a;
+    }
+  }
+  EXPECT_THROW((void)take_if_not_higher(system, candidate = Eigen::Matrix3Xd::Zero(3, 2)),
+               std::invalid_argument);
 }
 
 // The small pair (support/small_runs.hpp) sheared at two fields through four strains.

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 namespace mresim::mess_protocol {
 namespace {
@@ -40,6 +41,22 @@ Eigen::Matrix3Xd neighbour_field_start(const Eigen::Matrix3Xd& zero_load,
   check_same_size(kFn, zero_load, neighbour_loaded, "zero_load", "neighbour_loaded");
   check_same_size(kFn, zero_load, neighbour_zero_load, "zero_load", "neighbour_zero_load");
   return zero_load + (neighbour_loaded - neighbour_zero_load);
+}
+
+bool take_if_not_higher(mess::MessSystem& system, Eigen::Matrix3Xd& candidate) {
+  check_same_size("take_if_not_higher", system.positions(), candidate, "the system's positions",
+                  "candidate");
+  const Eigen::Matrix3Xd magnetization = system.magnetizations();
+  const bool history = system.has_magnetization_history();
+  const double current = system.evaluate(nullptr).potential;
+  if (history) system.set_magnetizations(magnetization);
+  std::swap(system.mutable_positions(), candidate);
+  system.apply_constraints();
+  const double predicted = system.evaluate(nullptr).potential;
+  if (std::isfinite(predicted) && predicted <= current) return true;
+  std::swap(system.mutable_positions(), candidate);
+  if (history) system.set_magnetizations(magnetization);
+  return false;
 }
 
 }  // namespace mresim::mess_protocol

@@ -26,6 +26,8 @@
 #include <Eigen/Core>
 #include <string>
 
+#include "mresim/mess/system/system_energy.hpp"
+
 namespace mresim::mess_protocol {
 
 // How a step's relaxation started (StepRecord::start, /steps/solver/start in results.h5).
@@ -48,5 +50,12 @@ Eigen::Matrix3Xd secant_start(const Eigen::Matrix3Xd& previous, const Eigen::Mat
 Eigen::Matrix3Xd neighbour_field_start(const Eigen::Matrix3Xd& zero_load,
                                        const Eigen::Matrix3Xd& neighbour_loaded,
                                        const Eigen::Matrix3Xd& neighbour_zero_load);
+
+// Moves `candidate` into the system where its potential is not above that of the system's own
+// positions, both at the system's field and constraints (the candidate's held coordinates are
+// written from them) with M solved at each from the system's magnetization history. Returns
+// whether it did; if not, the system's positions and magnetizations are as they were, bit for
+// bit. Makes two evaluations. `candidate` is left with the positions not kept.
+bool take_if_not_higher(mess::MessSystem& system, Eigen::Matrix3Xd& candidate);
 
 }  // namespace mresim::mess_protocol

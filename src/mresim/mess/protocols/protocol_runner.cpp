@@ -166,21 +166,9 @@ std::string ProtocolRunner::predict_start(const StepSpec& step, const ProtocolSt
                               state.references[neighbour].load());
     kind = step_start::kNeighbourField;
   }
-  // Keep the start with the lower potential, both with this step's faces and field; M is solved
-  // at each (evaluate), and set back to the previous state's where that start stays.
-  const Eigen::Matrix3Xd magnetization = system_.magnetizations();
-  const double previous_potential = system_.evaluate(nullptr).potential;
-  system_.set_magnetizations(magnetization);
-  std::swap(system_.mutable_positions(), candidate);
-  system_.apply_constraints();
-  const double predicted_potential = system_.evaluate(nullptr).potential;
+  // The start with the lower potential, both with this step's faces and field.
   evaluations += 2;
-  if (std::isfinite(predicted_potential) && predicted_potential <= previous_potential) {
-    return kind;
-  }
-  std::swap(system_.mutable_positions(), candidate);
-  system_.set_magnetizations(magnetization);
-  return step_start::kPredictionRejected;
+  return take_if_not_higher(system_, candidate) ? kind : step_start::kPredictionRejected;
 }
 
 const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
