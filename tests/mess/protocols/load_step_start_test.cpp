@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "../../support/temp_dir.hpp"
+#include "../support/checkpoint_round_trip.hpp"
 #include "../support/mess_test_support.hpp"
 #include "../support/small_runs.hpp"
 #include "mresim/mess/outputs/checkpoint.hpp"
@@ -184,15 +185,9 @@ TEST(LoadStepStart, ResumedFromACheckpointEqualsTheUninterruptedRun) {
 
   const mresim::testing::TempDir dir;
   const auto checkpoint = dir / "checkpoint.h5";
-  {
-    ProtocolRunner first(spec);
-    ProtocolState partial = first.initial_state();
-    // Stops before the neighbour-field step 3 and the secant steps after it.
-    for (int i = 0; i < 3; ++i) first.run_next_step(partial);
-    write_checkpoint(checkpoint, partial, first, toml, "test.toml");
-  }
   ProtocolRunner second(spec);
-  ProtocolState resumed = read_checkpoint(checkpoint, second, toml);
+  // Interrupted before the neighbour-field step 3 and the secant steps after it.
+  ProtocolState resumed = testing::resumed_after(toml, 3, checkpoint, second);
   second.run(resumed, nullptr);
   ASSERT_EQ(resumed.records.size(), full.size());
   for (std::size_t i = 0; i < full.size(); ++i) {

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "../../support/temp_dir.hpp"
+#include "../support/checkpoint_round_trip.hpp"
 #include "../support/small_runs.hpp"
 #include "mresim/mess/analysis/modulus_fit.hpp"
 #include "mresim/mess/lattice/stiffness.hpp"
@@ -65,14 +66,8 @@ TEST(MessProtocolHysteresis, ResumedFromACheckpointEqualsTheUninterruptedRun) {
 
   const mresim::testing::TempDir dir;
   const auto checkpoint = dir / "checkpoint.h5";
-  {
-    ProtocolRunner first(spec);
-    ProtocolState partial = first.initial_state();
-    for (int i = 0; i < 4; ++i) first.run_next_step(partial);
-    write_checkpoint(checkpoint, partial, first, toml, "test.toml");
-  }
   ProtocolRunner second(spec);  // a new process would start like this
-  ProtocolState resumed = read_checkpoint(checkpoint, second, toml);
+  ProtocolState resumed = testing::resumed_after(toml, 4, checkpoint, second);
   ASSERT_EQ(resumed.next_step, 4U);
   second.run(resumed, nullptr);
 
