@@ -3,8 +3,9 @@
 // system: the relaxed state and M are bitwise those of a single-process minimise() and the
 // same on every process, the evaluation count the same, for the seed profile (its
 // conservative phase, then the forces-only phase on the centre voxel's forces) with all faces
-// held. Also the helpers' collective contracts (sum_in_rank_order, any_process). Run on one
-// process by ctest and on two and three in mess_distributed_two_ranks/_three_ranks.
+// held, with the plain and with the multilevel preconditioner. Also the helpers' collective
+// contracts (sum_in_rank_order, any_process). Run on one process by ctest and on two and three in
+// mess_distributed_two_ranks/_three_ranks.
 
 #include <gtest/gtest.h>
 
@@ -49,14 +50,14 @@ mess::MessSystem held_pair(std::array<int, 3> cells = {6, 7, 10},
   return system;
 }
 
-// Relaxes `single` on this process alone and a copy of it over all processes, and checks
-// that both converge to bitwise the same positions and M with the same evaluations. Returns
-// the split relaxation's result (the same on every process) and the single one's.
+// Relaxes `single` on this process alone and a copy of it over all processes, both with
+// `options`, and checks that both converge to bitwise the same positions and M with the same
+// evaluations. Returns the split relaxation's result (the same on every process) and the single
+// one's.
 std::pair<mess::MinimiserResult, mess::MinimiserResult> expect_split_relaxation_bitwise(
-    mess::MessSystem& single) {
+    mess::MessSystem& single, mess::MinimiserOptions options = {}) {
   mess::MessSystem split = single;
-  const mess::MinimiserResult a = mess::minimise(single);
-  mess::MinimiserOptions options;
+  const mess::MinimiserResult a = mess::minimise(single, options);
   options.distributed = std::make_shared<mess::DistributedEvaluator>(MPI_COMM_WORLD);
   const mess::MinimiserResult b = mess::minimise(split, options);
   EXPECT_TRUE(a.converged) << mess::to_string(a.status);
@@ -90,6 +91,21 @@ TEST(DistributedMinimise, RelaxesALatticeOfSeveralBlocksToTheSingleProcessStateB
   ASSERT_GT(free_coordinates, 2 * mess::detail::kSumBlock);
   const auto [b, a] = expect_split_relaxation_bitwise(single);
   EXPECT_TRUE(a.forces_only_phase);
+}
+
+// The multilevel preconditioner (the default on lattices of 40,000 nodes or more, so at full
+// size), forced here on a small lattice: every process builds and applies it whole, to the same
+// whole vector, so the split relaxation stays bitwise the single-process one.
+TEST(DistributedMinimise, RelaxesWithTheMultilevelPreconditionerToTheSingleProcessStateBitwise) {
+  mess::MessSystem single = held_pair({12, 12, 24}, {{5, 6, 8}, {6, 6, 14}});
+  mess::MinimiserOptions options;
+  options.lbfgs_preconditioner = mess::LbfgsPreconditioner::multilevel;
+  const auto [b, a] = expect_split_relaxation_bitwise(single, options);
+  EXPECT_TRUE(a.forces_only_phase);
+  // The correction was built and used: the path differs from the plain preconditioner's.
+  mess::MessSystem plain = held_pair({12, 12, 24}, {{5, 6, 8}, {6, 6, 14}});
+  (void)mess::minimise(plain);
+  EXPECT_FALSE(plain.positions() == single.positions());
 }
 
 TEST(DistributedMinimise, NewtonIsRefused) {

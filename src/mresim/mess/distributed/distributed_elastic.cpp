@@ -1,5 +1,6 @@
 #include "mresim/mess/distributed/distributed_elastic.hpp"
 
+#include <omp.h>
 #include <petscdmda.h>
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 
 #include "mresim/mess/terms/elastic_formulas.hpp"
 #include "mresim/mess/terms/grid_stencil.hpp"
+#include "mresim/mess/terms/spring_rows.hpp"
 
 namespace mresim::mess {
 
@@ -93,7 +95,8 @@ DistributedElastic::DistributedElastic(const lattice::Lattice& lattice,
       known = stiffness_.end() - 1;
     }
     const auto o = offset - lattice::kForwardNeighbours.begin();
-    spring_class_[static_cast<std::size_t>(13 * ghosted.offset(first[0], first[1], first[2]) + o)] =
+    spring_class_[static_cast<std::size_t>(o * ghosted.node_count() +
+                                           ghosted.offset(first[0], first[1], first[2]))] =
         static_cast<std::uint8_t>(known - stiffness_.begin());
   }
   check_petsc(DMCreateLocalVector(decomposition.dm(), &local_), "DMCreateLocalVector");
@@ -160,92 +163,154 @@ DistributedElastic::Sums DistributedElastic::evaluate_cells(const PetscScalar* x
   return add_in_order(cell_sums);
 }
 
+spring_rows::Components DistributedElastic::components(std::int64_t node) const {
+  const std::int64_t nodes = decomposition_.ghosted().node_count();
+  const double* const c = components_.data();
+  return {c + node, c + nodes + node, c + 2 * nodes + node};
+}
+
+double* DistributedElastic::tensions_at(int ix, int iy, std::int64_t offset, int iz) const {
+  const NodeBox& ghosted = decomposition_.ghosted();
+  const std::int64_t line = std::int64_t{iy % 2} * ghosted.size[0] + (ix - ghosted.lower[0]);
+  return tensions_.data() + (line * 13 + offset) * ghosted.size[2] + (iz - ghosted.lower[2]);
+}
+
+void DistributedElastic::line_tensions(int ix, int iy, double* energy, double* rounding,
+                                       Sums& sums) const {
+  const NodeBox& owned = decomposition_.owned();
+  const NodeBox& ghosted = decomposition_.ghosted();
+  const std::int64_t nodes = ghosted.node_count();
+  const int z_begin = ghosted.lower[2];
+  const int z_end = ghosted.lower[2] + ghosted.size[2];
+  const int owned_z_begin = owned.lower[2];
+  const int owned_z_end = owned.lower[2] + owned.size[2];
+  const bool owned_line = owned.contains(ix, iy, owned_z_begin);
+  for (std::size_t o = 0; o < 13; ++o) {
+    const auto& [dx, dy, dz] = lattice::kForwardNeighbours[o];
+    // Both ends in the ghosted box.
+    if (!ghosted.contains(ix + dx, iy + dy, z_begin)) continue;
+    const int lo = std::max(z_begin, z_begin - dz);
+    const int hi = std::min(z_end, z_end - dz);
+    if (lo >= hi) continue;
+    const std::int64_t first = ghosted.offset(ix, iy, lo);
+    spring_rows::tensions(hi - lo, components(first),
+                          components(ghosted.offset(ix + dx, iy + dy, lo + dz)),
+                          spring_class_.data() + static_cast<std::int64_t>(o) * nodes + first,
+                          stiffness_.data(), rest_length_of_offset_[o],
+                          tensions_at(ix, iy, static_cast<std::int64_t>(o), lo), energy, rounding);
+    if (!owned_line) continue;
+    for (int iz = std::max(lo, owned_z_begin); iz < std::min(hi, owned_z_end); ++iz) {
+      sums[0] += energy[iz - lo];
+      sums[2] += rounding[iz - lo];
+    }
+  }
+}
+
+void DistributedElastic::line_spring_gradient(int ix, int iy, double* gx, double* gy,
+                                              double* gz) const {
+  const lattice::GridShape& shape = decomposition_.shape();
+  const NodeBox& owned = decomposition_.owned();
+  const NodeBox& ghosted = decomposition_.ghosted();
+  const int owned_z_begin = owned.lower[2];
+  const int owned_z_end = owned.lower[2] + owned.size[2];
+  const auto in_lattice = [&](int jx, int jy) {
+    return jx >= 0 && jx < shape.nx() && jy >= 0 && jy < shape.ny();
+  };
+  std::fill(gx, gx + owned.size[2], 0.0);
+  std::fill(gy, gy + owned.size[2], 0.0);
+  std::fill(gz, gz + owned.size[2], 0.0);
+  for (const int o : backward_order_) {
+    const auto& [dx, dy, dz] = lattice::kForwardNeighbours[static_cast<std::size_t>(o)];
+    if (!in_lattice(ix - dx, iy - dy)) continue;
+    const int lo = std::max(owned_z_begin, dz);
+    const int hi = std::min(owned_z_end, shape.nz() + dz);
+    if (lo >= hi) continue;
+    const std::int64_t k = lo - owned_z_begin;
+    spring_rows::add_backward(hi - lo, tensions_at(ix - dx, iy - dy, o, lo - dz),
+                              components(ghosted.offset(ix - dx, iy - dy, lo - dz)),
+                              components(ghosted.offset(ix, iy, lo)), gx + k, gy + k, gz + k);
+  }
+  for (std::size_t o = 0; o < 13; ++o) {
+    const auto& [dx, dy, dz] = lattice::kForwardNeighbours[o];
+    if (!in_lattice(ix + dx, iy + dy)) continue;
+    const int lo = std::max(owned_z_begin, -dz);
+    const int hi = std::min(owned_z_end, shape.nz() - dz);
+    if (lo >= hi) continue;
+    const std::int64_t k = lo - owned_z_begin;
+    spring_rows::subtract_forward(hi - lo, tensions_at(ix, iy, static_cast<std::int64_t>(o), lo),
+                                  components(ghosted.offset(ix, iy, lo)),
+                                  components(ghosted.offset(ix + dx, iy + dy, lo + dz)), gx + k,
+                                  gy + k, gz + k);
+  }
+}
+
+void DistributedElastic::line_gradient(int ix, int iy, const NodeBox& cells, double* gx, double* gy,
+                                       double* gz, PetscScalar* g) const {
+  const lattice::GridShape& shape = decomposition_.shape();
+  const NodeBox& owned = decomposition_.owned();
+  line_spring_gradient(ix, iy, gx, gy, gz);
+  for (int iz = owned.lower[2]; iz < owned.lower[2] + owned.size[2]; ++iz) {
+    const std::int64_t k = iz - owned.lower[2];
+    Eigen::Vector3d sum(gx[k], gy[k], gz[k]);
+    for (const auto& [dx, dy, dz] : kCellsOfNode) {
+      const int cx = ix - dx;
+      const int cy = iy - dy;
+      const int cz = iz - dz;
+      if (cx < 0 || cx >= shape.nx() - 1 || cy < 0 || cy >= shape.ny() - 1 || cz < 0 ||
+          cz >= shape.nz() - 1) {
+        continue;
+      }
+      sum += elastic::vertex_gradient(cell_terms_.data() + 9 * cells.offset(cx, cy, cz),
+                                      2 * dx + 4 * dy + dz);
+    }
+    Eigen::Map<Eigen::Vector3d>(g + 3 * owned.offset(ix, iy, iz)) = sum;
+  }
+}
+
 DistributedElastic::Sums DistributedElastic::evaluate_nodes(const PetscScalar* x,
                                                             const NodeBox& cells,
                                                             PetscScalar* g) const {
-  const lattice::GridShape& shape = decomposition_.shape();
-  const int nx = shape.nx();
-  const int ny = shape.ny();
-  const int nz = shape.nz();
   const NodeBox& owned = decomposition_.owned();
   const NodeBox& ghosted = decomposition_.ghosted();
-  const bool want_gradient = g != nullptr;
+  const std::int64_t nodes = ghosted.node_count();
+  const std::int64_t row_lines = ghosted.size[0];
+  components_.resize(static_cast<std::size_t>(3 * nodes));
+  tensions_.resize(static_cast<std::size_t>(2 * row_lines * 13 * ghosted.size[2]));
+  std::vector<Sums> line_sums(static_cast<std::size_t>(row_lines * ghosted.size[1]), Sums{});
+  // Per thread: a line's energies and roundings, and an owned line's gradient.
+  const std::int64_t scratch_per_thread =
+      2 * std::int64_t{ghosted.size[2]} + 3 * std::int64_t{owned.size[2]};
+  row_scratch_.resize(static_cast<std::size_t>(omp_get_max_threads() * scratch_per_thread));
+  double* const c = components_.data();
 
-  // Nodes: each owned node's springs in increasing spring index (backward, then forward) and
-  // then its cells in increasing cell index, as SpringStencil and CellStencil gather them. The
-  // energy of the springs it owns (its forward ones).
-  const std::int64_t lines = std::int64_t{owned.size[0]} * owned.size[1];
-  std::vector<Sums> node_sums(static_cast<std::size_t>(lines), Sums{});
-  // Index steps of the forward offsets in the ghosted box and of a node's cells in the cell
-  // box, for the nodes away from the lattice's faces (all their springs and cells exist).
-  std::array<std::int64_t, 13> ghosted_step{};
-  for (std::size_t o = 0; o < ghosted_step.size(); ++o) {
-    const auto& step = lattice::kForwardNeighbours[o];
-    ghosted_step[o] = ghosted.offset(ghosted.lower[0] + step[0], ghosted.lower[1] + step[1],
-                                     ghosted.lower[2] + step[2]);
-  }
-  std::array<std::int64_t, 8> cell_step{};
-  for (std::size_t k = 0; k < cell_step.size(); ++k) {
-    const auto& [dx, dy, dz] = kCellsOfNode[k];
-    cell_step[k] = cells.offset(cells.lower[0] + dx, cells.lower[1] + dy, cells.lower[2] + dz);
-  }
-#pragma omp parallel for schedule(static)
-  for (std::int64_t line = 0; line < lines; ++line) {
-    const int ix = owned.lower[0] + static_cast<int>(line % owned.size[0]);
-    const int iy = owned.lower[1] + static_cast<int>(line / owned.size[0]);
-    Sums& sums = node_sums[static_cast<std::size_t>(line)];
-    for (int iz = owned.lower[2]; iz < owned.lower[2] + owned.size[2]; ++iz) {
-      const bool inside = ix > 0 && ix < nx - 1 && iy > 0 && iy < ny - 1 && iz > 0 && iz < nz - 1;
-      const std::int64_t self = ghosted.offset(ix, iy, iz);
-      const Map3 xn(x + 3 * self);
-      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      if (want_gradient) {
-        for (const int o : backward_order_) {
-          const auto u = static_cast<std::size_t>(o);
-          const auto& step = lattice::kForwardNeighbours[u];
-          if (!inside && (ix - step[0] < 0 || ix - step[0] >= nx || iy - step[1] < 0 ||
-                          iy - step[1] >= ny || iz - step[2] < 0 || iz - step[2] >= nz)) {
-            continue;
-          }
-          const std::int64_t m = self - ghosted_step[u];
-          const std::uint8_t k = spring_class_[static_cast<std::size_t>(13 * m + o)];
-          const Eigen::Vector3d r = xn - Map3(x + 3 * m);
-          const elastic::SpringValue value =
-              elastic::spring_value(stiffness_[k], rest_length_of_offset_[u], r.norm());
-          sum += Eigen::Vector3d(value.tension * r);
-        }
+#pragma omp parallel
+  {
+    double* const energy = row_scratch_.data() + omp_get_thread_num() * scratch_per_thread;
+    double* const rounding = energy + ghosted.size[2];
+    double* const gx = rounding + ghosted.size[2];
+    double* const gy = gx + owned.size[2];
+    double* const gz = gy + owned.size[2];
+    // The ghosted positions as three component arrays, as the row formulas take them.
+#pragma omp for schedule(static)
+    for (std::int64_t n = 0; n < nodes; ++n) {
+      c[n] = x[3 * n];
+      c[nodes + n] = x[3 * n + 1];
+      c[2 * nodes + n] = x[3 * n + 2];
+    }
+    for (int iy = ghosted.lower[1]; iy < ghosted.lower[1] + ghosted.size[1]; ++iy) {
+#pragma omp for schedule(static)
+      for (std::int64_t l = 0; l < row_lines; ++l) {
+        line_tensions(ghosted.lower[0] + static_cast<int>(l), iy, energy, rounding,
+                      line_sums[static_cast<std::size_t>((iy - ghosted.lower[1]) * row_lines + l)]);
       }
-      for (std::size_t o = 0; o < 13; ++o) {
-        const std::uint8_t k = spring_class_[static_cast<std::size_t>(13 * self) + o];
-        if (k == kNoSpring) continue;
-        const Eigen::Vector3d r = Map3(x + 3 * (self + ghosted_step[o])) - xn;
-        const elastic::SpringValue value =
-            elastic::spring_value(stiffness_[k], rest_length_of_offset_[o], r.norm());
-        sum -= Eigen::Vector3d(value.tension * r);
-        sums[0] += value.energy;
-        sums[2] += value.rounding;
+      if (g == nullptr || iy < owned.lower[1] || iy >= owned.lower[1] + owned.size[1]) continue;
+#pragma omp for schedule(static)
+      for (std::int64_t l = 0; l < owned.size[0]; ++l) {
+        line_gradient(owned.lower[0] + static_cast<int>(l), iy, cells, gx, gy, gz, g);
       }
-      if (!want_gradient) continue;
-      const std::int64_t corner_cell =
-          cells.contains(ix, iy, iz) ? cells.offset(ix, iy, iz) : -1;  // the cell at (0, 0, 0)
-      for (std::size_t c = 0; c < kCellsOfNode.size(); ++c) {
-        const auto& [dx, dy, dz] = kCellsOfNode[c];
-        std::int64_t cell = 0;
-        if (inside) {
-          cell = corner_cell - cell_step[c];
-        } else {
-          const int cx = ix - dx;
-          const int cy = iy - dy;
-          const int cz = iz - dz;
-          if (cx < 0 || cx >= nx - 1 || cy < 0 || cy >= ny - 1 || cz < 0 || cz >= nz - 1) continue;
-          cell = cells.offset(cx, cy, cz);
-        }
-        sum += elastic::vertex_gradient(cell_terms_.data() + 9 * cell, 2 * dx + 4 * dy + dz);
-      }
-      Eigen::Map<Eigen::Vector3d>(g + 3 * owned.offset(ix, iy, iz)) = sum;
     }
   }
-  return add_in_order(node_sums);
+  return add_in_order(line_sums);
 }
 
 }  // namespace mresim::mess

@@ -8,15 +8,21 @@
 //
 // Same numbers as one process. Every node gathers its springs and cells in the order of the
 // single-process kernels (terms/grid_stencil.hpp: increasing spring and cell index) with the
-// same per-spring and per-cell formulas (terms/elastic_formulas.hpp), so the gradient is
-// bitwise ElasticTerms::evaluate's on any number of processes and threads. Each spring's
-// tension is computed at both of its ends (no per-spring scratch array). The energies are
-// summed in another order (per grid line, then over processes), so they agree with the
-// single-process sums to rounding (relative 1e-15 or so), not bitwise.
+// same per-spring and per-cell formulas, so the gradient is bitwise ElasticTerms::evaluate's on
+// any number of processes and threads. The springs run as the single-process spring kernel
+// runs them, in SIMD rows along z (terms/spring_rows.hpp): each row of z-lines (one y) first
+// computes the tensions of its springs once, offset by offset, then the gradient of its owned
+// nodes from its own tensions (forward springs) and the previous row's (backward springs, which
+// start at most one y below), so only two rows' tensions are kept. The cells use
+// terms/elastic_formulas.hpp per cell. The energies are summed in another order (per grid line,
+// then over processes), so they agree with the single-process sums to rounding (relative 1e-15
+// or so), not bitwise.
 //
 // Memory per process: one byte per forward spring of its ghosted nodes (the spring's stiffness
 // as an index into a table of the lattice's distinct spring constants), 72 bytes per cell
-// touching its nodes (gradient coefficients), and PETSc's ghosted position vector. The set-up
+// touching its nodes (gradient coefficients), the ghosted positions as three component arrays
+// (24 bytes per node), two rows' tensions (13 doubles per node of two of its y-rows), and
+// PETSc's ghosted position vector. The set-up
 // reads the whole lattice, which every process builds today (docs/mpi.md: what is distributed
 // so far and what is next).
 
@@ -29,6 +35,7 @@
 #include "mresim/mess/distributed/lattice_decomposition.hpp"
 #include "mresim/mess/lattice/lattice.hpp"
 #include "mresim/mess/terms/elastic_terms.hpp"
+#include "mresim/mess/terms/spring_rows.hpp"
 
 namespace mresim::mess {
 
@@ -60,8 +67,22 @@ class DistributedElastic {
   // the owned ones (lower corner owned) and, if asked, every one's gradient coefficients.
   Sums evaluate_cells(const PetscScalar* x, const NodeBox& cells, bool want_gradient) const;
   // The owned nodes: the energy of their forward springs and, if g is not null, the gradient
-  // (springs, then cells) at each.
+  // (springs, then cells) at each; row by row (one y), each row's lines in parallel.
   Sums evaluate_nodes(const PetscScalar* x, const NodeBox& cells, PetscScalar* g) const;
+  // The ghosted z-line (ix, iy): the tensions of its forward springs with both ends in the
+  // ghosted box (tensions_at), and, on an owned line, the owned springs' energies and rounding
+  // scales added to sums[0] and sums[2]. energy, rounding: scratch of the ghosted box's height.
+  void line_tensions(int ix, int iy, double* energy, double* rounding, Sums& sums) const;
+  // The owned z-line (ix, iy): g at its nodes, springs (gx, gy, gz: scratch of the owned
+  // height) then cells; its row's and the row below's tensions must be computed.
+  void line_gradient(int ix, int iy, const NodeBox& cells, double* gx, double* gy, double* gz,
+                     PetscScalar* g) const;
+  // gx, gy, gz = the springs' part of the gradient of the owned z-line (ix, iy), each node's
+  // springs in increasing spring index (backward, then forward), as SpringStencil gathers them.
+  void line_spring_gradient(int ix, int iy, double* gx, double* gy, double* gz) const;
+  // The ghosted node's component arrays, and a spring tension's slot (two rows of y kept).
+  [[nodiscard]] spring_rows::Components components(std::int64_t node) const;
+  [[nodiscard]] double* tensions_at(int ix, int iy, std::int64_t offset, int iz) const;
 
   const LatticeDecomposition& decomposition_;
   double kappa_ = 0.0;                              // J/m^3
@@ -71,11 +92,18 @@ class DistributedElastic {
   std::array<std::int64_t, 13> delta_{};            // node index change of each forward offset
   std::array<int, 13> backward_order_{};            // offsets by decreasing delta
   std::vector<double> stiffness_;                   // the distinct spring constants (N/m)
-  // Per ghosted node (NodeBox::offset of the ghosted box) and forward offset: index into
-  // stiffness_, or kNoSpring where the neighbour is outside the lattice.
+  // Per forward offset o and ghosted node n (NodeBox::offset of the ghosted box), at
+  // o x (ghosted nodes) + n: index into stiffness_, or kNoSpring where the neighbour is outside
+  // the lattice.
   std::vector<std::uint8_t> spring_class_;
   Vec local_ = nullptr;                     // positions of the ghosted box
   mutable std::vector<double> cell_terms_;  // 9 per cell touching an owned node
+  // One evaluation's scratch: the ghosted positions as x, y and z arrays; each forward spring's
+  // tension at its first end (spring_class_'s layout); per thread a line's energies and an owned
+  // line's gradient.
+  mutable std::vector<double> components_;
+  mutable std::vector<double> tensions_;
+  mutable std::vector<double> row_scratch_;
 };
 
 }  // namespace mresim::mess
