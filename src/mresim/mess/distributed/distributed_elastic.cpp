@@ -66,8 +66,7 @@ DistributedElastic::DistributedElastic(const lattice::Lattice& lattice,
     throw std::invalid_argument("DistributedElastic: volume_force_factor must be > 0, got " +
                                 std::to_string(volume_force_factor));
   }
-  delta_ = forward_offset_deltas(shape);
-  backward_order_ = backward_offset_order(delta_);
+  backward_order_ = backward_offset_order(forward_offset_deltas(shape));
 
   // The stiffness of every forward spring of a ghosted node, as a class byte.
   const NodeBox& ghosted = decomposition.ghosted();

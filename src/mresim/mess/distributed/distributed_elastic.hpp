@@ -22,9 +22,8 @@
 // as an index into a table of the lattice's distinct spring constants), 72 bytes per cell
 // touching its nodes (gradient coefficients), the ghosted positions as three component arrays
 // (24 bytes per node), two rows' tensions (13 doubles per node of two of its y-rows), and
-// PETSc's ghosted position vector. The set-up
-// reads the whole lattice, which every process builds today (docs/mpi.md: what is distributed
-// so far and what is next).
+// PETSc's ghosted position vector. The set-up reads the whole lattice, which every process
+// builds today (docs/mpi.md: what is distributed so far and what is next).
 
 #include <petscvec.h>
 
@@ -89,7 +88,6 @@ class DistributedElastic {
   double cell_volume_ = 0.0;                        // V0 = l_e^3
   double volume_factor_ = 1.0;                      // volume_force_factor
   std::array<double, 13> rest_length_of_offset_{};  // by forward offset
-  std::array<std::int64_t, 13> delta_{};            // node index change of each forward offset
   std::array<int, 13> backward_order_{};            // offsets by decreasing delta
   std::vector<double> stiffness_;                   // the distinct spring constants (N/m)
   // Per forward offset o and ghosted node n (NodeBox::offset of the ghosted box), at
@@ -98,8 +96,8 @@ class DistributedElastic {
   std::vector<std::uint8_t> spring_class_;
   Vec local_ = nullptr;                     // positions of the ghosted box
   mutable std::vector<double> cell_terms_;  // 9 per cell touching an owned node
-  // One evaluation's scratch: the ghosted positions as x, y and z arrays; each forward spring's
-  // tension at its first end (spring_class_'s layout); per thread a line's energies and an owned
+  // One evaluation's scratch: the ghosted positions as x, y and z arrays; the forward springs'
+  // tensions of two rows of z-lines (tensions_at); per thread a line's energies and an owned
   // line's gradient.
   mutable std::vector<double> components_;
   mutable std::vector<double> tensions_;
