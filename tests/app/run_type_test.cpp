@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "../support/toml_text.hpp"
 #include "mresim/app/threads.hpp"
 
 namespace mresim::app {
@@ -9,9 +10,7 @@ namespace {
 
 // The test-only run type "test_dummy" is registered by tests/support/dummy_run_type.cpp.
 
-config::TableReader parse(const std::string& text) {
-  return config::TableReader::parse_string(text, "test.toml");
-}
+using mresim::testing::parse;
 
 std::string config_error_of(const std::string& text) {
   try {

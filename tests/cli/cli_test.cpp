@@ -2,6 +2,7 @@
 // MRESIM_CLI_PATH is the real command; MRESIM_TESTBED_PATH is the same command with the
 // test-only run type "test_dummy" (tests/support/dummy_run_type.cpp) linked in.
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -12,32 +13,29 @@
 #include <regex>
 #include <string>
 
+#include "../support/child_process.hpp"
 #include "../support/hdf5_read.hpp"
 #include "../support/temp_dir.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
+using mresim::testing::CommandResult;
 using mresim::testing::Hdf5Reader;
+using mresim::testing::listing;
 using mresim::testing::read_text;
 using mresim::testing::TempDir;
 using mresim::testing::write_text;
 
-struct Result {
-  int status = -1;
-  std::string out;
-  std::string err;
-};
-
 // Runs `program args` with `env` assignments prepended, in `dir`; captures stdout and stderr.
-Result run_in(const fs::path& dir, const std::string& program, const std::string& args,
-              const std::string& env = {}) {
+CommandResult run_shell_in(const fs::path& dir, const std::string& program, const std::string& args,
+                           const std::string& env = {}) {
   const fs::path out = dir / ".stdout";
   const fs::path err = dir / ".stderr";
   const std::string command = "cd '" + dir.string() + "' && " + env + " '" + program + "' " + args +
                               " >'" + out.string() + "' 2>'" + err.string() + "' </dev/null";
   const int raw = std::system(command.c_str());
-  Result result;
+  CommandResult result;
   result.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
   result.out = read_text(out);
   result.err = read_text(err);
@@ -46,19 +44,11 @@ Result run_in(const fs::path& dir, const std::string& program, const std::string
   return result;
 }
 
-Result mresim(const fs::path& dir, const std::string& args, const std::string& env = {}) {
-  return run_in(dir, MRESIM_CLI_PATH, args, env);
+CommandResult mresim(const fs::path& dir, const std::string& args, const std::string& env = {}) {
+  return run_shell_in(dir, MRESIM_CLI_PATH, args, env);
 }
-Result testbed(const fs::path& dir, const std::string& args, const std::string& env = {}) {
-  return run_in(dir, MRESIM_TESTBED_PATH, args, env);
-}
-
-// The names in `dir`, sorted, ignoring nothing.
-std::vector<std::string> listing(const fs::path& dir) {
-  std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
+CommandResult testbed(const fs::path& dir, const std::string& args, const std::string& env = {}) {
+  return run_shell_in(dir, MRESIM_TESTBED_PATH, args, env);
 }
 
 const char* const kDummyRun =
@@ -74,34 +64,34 @@ bool have_python3() { return std::system("python3 -c '' >/dev/null 2>&1") == 0; 
 
 TEST(Cli, HelpDocumentsEveryCommandAndOption) {
   const TempDir dir;
-  const Result top = mresim(dir.path(), "--help");
+  const CommandResult top = mresim(dir.path(), "--help");
   EXPECT_EQ(top.status, 0);
   for (const char* word : {"run", "info", "plot", "types", "--version"}) {
     EXPECT_NE(top.out.find(word), std::string::npos) << word;
   }
-  const Result run = mresim(dir.path(), "run --help");
+  const CommandResult run = mresim(dir.path(), "run --help");
   EXPECT_EQ(run.status, 0);
   for (const char* word : {"FILE", "--out", "--threads", "--no-plot", "Run types"}) {
     EXPECT_NE(run.out.find(word), std::string::npos) << word;
   }
-  const Result info = mresim(dir.path(), "info --help");
+  const CommandResult info = mresim(dir.path(), "info --help");
   EXPECT_EQ(info.status, 0);
   EXPECT_NE(info.out.find("--json"), std::string::npos);
-  const Result plot = mresim(dir.path(), "plot --help");
+  const CommandResult plot = mresim(dir.path(), "plot --help");
   EXPECT_EQ(plot.status, 0);
   EXPECT_NE(plot.out.find("DIR"), std::string::npos);
 }
 
 TEST(Cli, PrintsItsVersion) {
   const TempDir dir;
-  const Result r = mresim(dir.path(), "--version");
+  const CommandResult r = mresim(dir.path(), "--version");
   EXPECT_EQ(r.status, 0);
   EXPECT_EQ(r.out, std::string("mresim ") + mresim::kVersion + "\n");
 }
 
 TEST(Cli, CommandLineMistakesExitWithStatus2) {
   const TempDir dir;
-  const Result none = mresim(dir.path(), "");
+  const CommandResult none = mresim(dir.path(), "");
   EXPECT_EQ(none.status, 2);
   EXPECT_NE(none.err.find("mresim: error: "), std::string::npos);
   EXPECT_EQ(mresim(dir.path(), "run").status, 2);
@@ -113,7 +103,7 @@ TEST(Cli, CommandLineMistakesExitWithStatus2) {
 TEST(Cli, TypesListsTheRegisteredRunTypes) {
   const TempDir dir;
   EXPECT_EQ(mresim(dir.path(), "types").status, 0);
-  const Result r = testbed(dir.path(), "types");
+  const CommandResult r = testbed(dir.path(), "types");
   EXPECT_EQ(r.status, 0);
   EXPECT_TRUE(std::regex_search(r.out, std::regex(R"((^|\n)  test_dummy +Test-only run type\n)")))
       << r.out;
@@ -122,7 +112,7 @@ TEST(Cli, TypesListsTheRegisteredRunTypes) {
 TEST(Cli, AnInvalidRunFileExitsWith2AndWritesNothing) {
   const TempDir dir;
   write_text(dir / "bad.toml", "[run]\ntype = \"no_such_type\"\n");
-  const Result r = testbed(dir.path(), "run bad.toml");
+  const CommandResult r = testbed(dir.path(), "run bad.toml");
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.err.rfind("mresim: error: run.type = \"no_such_type\": ", 0), 0U) << r.err;
   EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"bad.toml"});
@@ -130,12 +120,12 @@ TEST(Cli, AnInvalidRunFileExitsWith2AndWritesNothing) {
 
 TEST(Cli, MissingAndMalformedFilesExitWith2) {
   const TempDir dir;
-  const Result missing = mresim(dir.path(), "run absent.toml");
+  const CommandResult missing = mresim(dir.path(), "run absent.toml");
   EXPECT_EQ(missing.status, 2);
   EXPECT_EQ(missing.err,
             "mresim: error: cannot read run file 'absent.toml': No such file or directory\n");
   write_text(dir / "broken.toml", "[run\n");
-  const Result broken = mresim(dir.path(), "info broken.toml");
+  const CommandResult broken = mresim(dir.path(), "info broken.toml");
   EXPECT_EQ(broken.status, 2);
   EXPECT_EQ(broken.err.rfind("mresim: error: broken.toml:1:", 0), 0U) << broken.err;
   EXPECT_NE(broken.err.find("TOML syntax error"), std::string::npos);
@@ -145,7 +135,7 @@ TEST(Cli, MissingAndMalformedFilesExitWith2) {
 TEST(Cli, RunWritesACompleteRunDirectory) {
   const TempDir dir;
   write_text(dir / "demo.toml", kDummyRun);
-  const Result r = testbed(dir.path(), "run demo.toml --no-plot");
+  const CommandResult r = testbed(dir.path(), "run demo.toml --no-plot");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.out, "mresim: results written to demo\n");
   EXPECT_NE(r.err.find("test_dummy: done 3/3"), std::string::npos) << r.err;
@@ -181,7 +171,7 @@ TEST(Cli, ThreadsComeFromTheCommandLineOrTheRunFile) {
 TEST(Cli, AFailingRunExitsWith1AndLeavesNothing) {
   const TempDir dir;
   write_text(dir / "fail.toml", "[run]\ntype = \"test_dummy\"\n[dummy]\nsteps = 5\nfail_at = 2\n");
-  const Result r = testbed(dir.path(), "run fail.toml --no-plot");
+  const CommandResult r = testbed(dir.path(), "run fail.toml --no-plot");
   EXPECT_EQ(r.status, 1);
   // The progress lines of the steps before (stderr is no terminal), then the error.
   const std::string error = "mresim: error: dummy failure at step 2\n";
@@ -193,7 +183,7 @@ TEST(Cli, AFailingRunExitsWith1AndLeavesNothing) {
 TEST(Cli, UnknownKeysAreRejectedBeforeAnythingIsWritten) {
   const TempDir dir;
   write_text(dir / "typo.toml", "[run]\ntype = \"test_dummy\"\n[dummy]\nsteps = 2\nscael = 1\n");
-  const Result r = testbed(dir.path(), "run typo.toml --out results");
+  const CommandResult r = testbed(dir.path(), "run typo.toml --out results");
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.err,
             "mresim: error: unknown key 'dummy.scael' in [dummy]; allowed keys: fail_at, nan_at, "
@@ -206,7 +196,7 @@ TEST(Cli, RefusesToOverwriteADirectoryThatIsNotARun) {
   write_text(dir / "demo.toml", kDummyRun);
   fs::create_directories(dir / "data");
   write_text(dir / "data" / "keep.txt", "precious");
-  const Result r = testbed(dir.path(), "run demo.toml --out data --no-plot");
+  const CommandResult r = testbed(dir.path(), "run demo.toml --out data --no-plot");
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.err,
             "mresim: error: output directory 'data' exists and was not written by mresim (it has "
@@ -230,7 +220,7 @@ TEST(Cli, ReplacesAnEarlierRun) {
 TEST(Cli, InfoDescribesTheRunAsTextOrJson) {
   const TempDir dir;
   write_text(dir / "demo.toml", kDummyRun);
-  const Result text = testbed(dir.path(), "info demo.toml");
+  const CommandResult text = testbed(dir.path(), "info demo.toml");
   ASSERT_EQ(text.status, 0) << text.err;
   EXPECT_EQ(text.out,
             "[run]\n"
@@ -243,7 +233,7 @@ TEST(Cli, InfoDescribesTheRunAsTextOrJson) {
             "  steps         3\n"
             "  scale         0.5 m  length of one step\n"
             "  total_length  1.5 m\n");
-  const Result json = testbed(dir.path(), "info demo.toml --json");
+  const CommandResult json = testbed(dir.path(), "info demo.toml --json");
   ASSERT_EQ(json.status, 0) << json.err;
   const auto parsed = nlohmann::json::parse(json.out);
   EXPECT_EQ(parsed["dummy"]["total_length"]["value"].get<double>(), 1.5);
@@ -254,14 +244,14 @@ TEST(Cli, InfoDescribesTheRunAsTextOrJson) {
 // A stand-in for python/mresim_plot.py that records its argument and exits with `status`.
 void write_fake_plot_script(const fs::path& python_dir, int status) {
   fs::create_directories(python_dir);
-  write_text(
-      python_dir / "mresim_plot.py",
-      "import os, sys\n"
-      "figures = os.path.join(sys.argv[1], 'figures')\n"
-      "os.makedirs(figures, exist_ok=True)\n"
-      "open(os.path.join(figures, 'backend.txt'), 'w').write(os.environ.get('MPLBACKEND', ''))\n"
-      "sys.exit(" +
-          std::to_string(status) + ")\n");
+  write_text(python_dir / "mresim_plot.py",
+             fmt::format("import os, sys\n"
+                         "figures = os.path.join(sys.argv[1], 'figures')\n"
+                         "os.makedirs(figures, exist_ok=True)\n"
+                         "open(os.path.join(figures, 'backend.txt'), 'w')"
+                         ".write(os.environ.get('MPLBACKEND', ''))\n"
+                         "sys.exit({})\n",
+                         status));
 }
 
 TEST(Cli, RunDrawsFiguresWithThePlotScript) {
@@ -270,8 +260,9 @@ TEST(Cli, RunDrawsFiguresWithThePlotScript) {
   write_fake_plot_script(dir / "py", 0);
   write_text(dir / "demo.toml", kDummyRun);
   const std::string env = "MRESIM_PYTHON_DIR='" + (dir / "py").string() + "'";
-  const Result r = testbed(dir.path(), "run demo.toml",
-                           "env -u MPLBACKEND MRESIM_PYTHON_DIR='" + (dir / "py").string() + "'");
+  const CommandResult r =
+      testbed(dir.path(), "run demo.toml",
+              "env -u MPLBACKEND MRESIM_PYTHON_DIR='" + (dir / "py").string() + "'");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(read_text(dir / "demo" / "figures" / "backend.txt"), "Agg");
   // `mresim plot` redraws and propagates the script's status.
@@ -291,21 +282,21 @@ TEST(Cli, PlotPassesTheViewOptionsToTheScript) {
   write_text(dir / "demo.toml", kDummyRun);
   ASSERT_EQ(testbed(dir.path(), "run demo.toml --no-plot").status, 0);
   const std::string env = "MRESIM_PYTHON_DIR='" + (dir / "py").string() + "'";
-  const Result r = mresim(dir.path(),
-                          "plot demo --step 0,3 --plane y@1 --plane=z=mid --particle 1 "
-                          "--field-map eps_xz --step last --animate",
-                          env);
+  const CommandResult r = mresim(dir.path(),
+                                 "plot demo --step 0,3 --plane y@1 --plane=z=mid --particle 1 "
+                                 "--field-map eps_xz --step last --animate",
+                                 env);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(read_text(dir / "demo" / "args.txt"),
             "--step|0,3|--step|last|--plane|y@1|--plane|z=mid|--particle|1|--field-map|eps_xz|"
             "--animate");
-  const Result before = mresim(dir.path(), "plot --step 2 --plane y=4.5e-6 demo", env);
+  const CommandResult before = mresim(dir.path(), "plot --step 2 --plane y=4.5e-6 demo", env);
   ASSERT_EQ(before.status, 0) << before.err;
   EXPECT_EQ(read_text(dir / "demo" / "args.txt"), "--step|2|--plane|y=4.5e-6");
-  const Result none = mresim(dir.path(), "plot demo", env);
+  const CommandResult none = mresim(dir.path(), "plot demo", env);
   ASSERT_EQ(none.status, 0) << none.err;
   EXPECT_EQ(read_text(dir / "demo" / "args.txt"), "");
-  const Result help = mresim(dir.path(), "plot --help");
+  const CommandResult help = mresim(dir.path(), "plot --help");
   for (const char* word : {"--step", "--plane", "--particle", "--field-map", "--animate"}) {
     EXPECT_NE(help.out.find(word), std::string::npos) << word;
   }
@@ -333,7 +324,7 @@ TEST(Cli, NewtonRunLeavesTheResultsReadableToThePlotScript) {
              "[box]\nsize = [9e-6, 9e-6, 17e-6]\n"
              "[field]\nmagnitudes = [0.02]\nsequence = \"up\"\n"
              "[solver]\nmethod = \"newton\"\n");
-  const Result r =
+  const CommandResult r =
       mresim(dir.path(), "run newton.toml", "MRESIM_PYTHON_DIR='" + (dir / "py").string() + "'");
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(fs::is_regular_file(dir / "newton" / "results.h5"));
@@ -344,7 +335,7 @@ TEST(Cli, AFailedPlotAfterASuccessfulRunExitsWith3) {
   const TempDir dir;
   write_fake_plot_script(dir / "py", 1);
   write_text(dir / "demo.toml", kDummyRun);
-  const Result r =
+  const CommandResult r =
       testbed(dir.path(), "run demo.toml", "MRESIM_PYTHON_DIR='" + (dir / "py").string() + "'");
   EXPECT_EQ(r.status, 3);
   EXPECT_NE(r.err.find("retry with 'mresim plot demo'"), std::string::npos) << r.err;
@@ -353,14 +344,14 @@ TEST(Cli, AFailedPlotAfterASuccessfulRunExitsWith3) {
 
 TEST(Cli, PlotExplainsWhatIsMissing) {
   const TempDir dir;
-  const Result not_run = mresim(dir.path(), "plot .");
+  const CommandResult not_run = mresim(dir.path(), "plot .");
   EXPECT_EQ(not_run.status, 2);
   EXPECT_EQ(not_run.err,
             "mresim: error: '.' is not an mresim run directory (no results.h5 in it)\n");
 
   fs::create_directories(dir / "run");
   write_text(dir / "run" / "results.h5", "");
-  const Result no_script =
+  const CommandResult no_script =
       mresim(dir.path(), "plot run", "MRESIM_PYTHON_DIR='" + (dir / "nowhere").string() + "'");
   EXPECT_EQ(no_script.status, 1);
   EXPECT_NE(no_script.err.find("mresim_plot.py' not found; set MRESIM_PYTHON_DIR"),
@@ -370,7 +361,7 @@ TEST(Cli, PlotExplainsWhatIsMissing) {
   // A missing interpreter, or one without matplotlib.
   write_fake_plot_script(dir / "py", 0);
   const std::string py_dir = "MRESIM_PYTHON_DIR='" + (dir / "py").string() + "'";
-  const Result no_python =
+  const CommandResult no_python =
       mresim(dir.path(), "plot run", "MRESIM_PYTHON=/nonexistent/python3 " + py_dir);
   EXPECT_EQ(no_python.status, 127);
   EXPECT_NE(no_python.err.find("/nonexistent/python3 was not found; install with: apt-get install"),
@@ -378,7 +369,7 @@ TEST(Cli, PlotExplainsWhatIsMissing) {
       << no_python.err;
   write_text(dir / "fake_python", "#!/bin/sh\nexit 1\n");
   fs::permissions(dir / "fake_python", fs::perms::owner_all);
-  const Result no_matplotlib = mresim(
+  const CommandResult no_matplotlib = mresim(
       dir.path(), "plot run", "MRESIM_PYTHON='" + (dir / "fake_python").string() + "' " + py_dir);
   EXPECT_EQ(no_matplotlib.status, 1);
   EXPECT_NE(no_matplotlib.err.find("cannot import matplotlib, numpy and h5py; install with: "
@@ -402,9 +393,10 @@ TEST(Cli, PlotFallsBackToTheSystemPythonWhenPathHasOneWithoutMatplotlib) {
   write_text(dir / "bin" / "python3",
              "#!/bin/sh\necho \"ModuleNotFoundError: No module named 'matplotlib'\" >&2\nexit 1\n");
   fs::permissions(dir / "bin" / "python3", fs::perms::owner_all);
-  const Result r = mresim(dir.path(), "plot run",
-                          "env -u MRESIM_PYTHON PATH='" + (dir / "bin").string() +
-                              ":/usr/bin:/bin' MRESIM_PYTHON_DIR='" + (dir / "py").string() + "'");
+  const CommandResult r =
+      mresim(dir.path(), "plot run",
+             "env -u MRESIM_PYTHON PATH='" + (dir / "bin").string() +
+                 ":/usr/bin:/bin' MRESIM_PYTHON_DIR='" + (dir / "py").string() + "'");
   EXPECT_EQ(r.status, 0) << r.err;
   // Some interpreter works, so nothing is said about the one that does not.
   EXPECT_EQ(r.err.find("No module named"), std::string::npos) << r.err;

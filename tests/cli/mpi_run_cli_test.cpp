@@ -58,14 +58,15 @@ bool have_mpirun() {
   return !mpirun.empty() && fs::exists(mpirun);
 }
 
-const std::string kExample = std::string(MRESIM_SOURCE_DIR) +
-                             "/examples/chapter4/small/fig4_11_pair_large_box_S6_5um_small.toml";
+const std::string kSmallPairExample =
+    std::string(MRESIM_SOURCE_DIR) +
+    "/examples/chapter4/small/fig4_11_pair_large_box_S6_5um_small.toml";
 
 // The small Fig. 4.11 pair (6,144 nodes, seed profile) through a shorter loop:
 // 0 -> 20 -> -20 -> 20 mT in 20 mT steps, one thread per process.
 std::vector<std::string> run_args(const std::string& out) {
-  return {"run", kExample, "--out",          out,     "--no-plot",    "-j",
-          "1",   "--set",  "field.max=0.02", "--set", "field.steps=1"};
+  return {"run", kSmallPairExample, "--out",          out,     "--no-plot",    "-j",
+          "1",   "--set",           "field.max=0.02", "--set", "field.steps=1"};
 }
 
 std::set<std::string> files_in(const fs::path& dir) {
@@ -176,7 +177,8 @@ TEST(MpiRunCli, StoppedRunResumesOverProcessesToTheSameResults) {
   if (!have_mpirun()) GTEST_SKIP() << "no MPI launcher (mpirun) found";
   const TempDir dir;
   // The whole small loop (11 steps, several seconds): long enough to stop in the middle.
-  const std::vector<std::string> args = {"run", kExample, "--out", "full", "--no-plot", "-j", "1"};
+  const std::vector<std::string> args = {
+      "run", kSmallPairExample, "--out", "full", "--no-plot", "-j", "1"};
   ASSERT_EQ(run(dir.path(), 2, args).status, 0);
 
   std::vector<std::string> stopped = {"--allow-run-as-root",
@@ -185,7 +187,7 @@ TEST(MpiRunCli, StoppedRunResumesOverProcessesToTheSameResults) {
                                       "2",
                                       MRESIM_CLI_PATH,
                                       "run",
-                                      kExample,
+                                      kSmallPairExample,
                                       "--out",
                                       "stopped",
                                       "--no-plot",

@@ -23,28 +23,15 @@
 namespace {
 
 namespace fs = std::filesystem;
+using mresim::testing::CommandResult;
 using mresim::testing::Hdf5Reader;
 using mresim::testing::read_text;
 using mresim::testing::TempDir;
 using mresim::testing::write_text;
 
-struct Result {
-  int status = -1;
-  std::string out;
-  std::string err;
-};
-
 // Runs the real `mresim` with `args` in `dir` and waits for it.
-Result mresim(const fs::path& dir, const std::vector<std::string>& args) {
-  const pid_t pid =
-      mresim::testing::start_child(MRESIM_CLI_PATH, args, dir, ".stdout-set", ".stderr-set");
-  Result r;
-  r.status = mresim::testing::wait_child(pid);
-  r.out = read_text(dir / ".stdout-set");
-  r.err = read_text(dir / ".stderr-set");
-  fs::remove(dir / ".stdout-set");
-  fs::remove(dir / ".stderr-set");
-  return r;
+CommandResult run_mresim_in(const fs::path& dir, const std::vector<std::string>& args) {
+  return mresim::testing::run_program(MRESIM_CLI_PATH, dir, args, "-set");
 }
 
 const fs::path kExample =
@@ -54,9 +41,11 @@ TEST(CliOverrides, ARunWithSetComputesAndRecordsTheOverriddenFile) {
   const TempDir dir;
   fs::copy_file(kExample, dir / "pair.toml");
   const std::string file = read_text(dir / "pair.toml");
-  ASSERT_EQ(mresim(dir.path(), {"run", "pair.toml", "--out", "plain", "--no-plot"}).status, 0);
-  const Result r = mresim(dir.path(), {"run", "pair.toml", "--out", "set", "--no-plot", "--set",
-                                       "field.max=0.5", "--set", "field.step=0.05"});
+  ASSERT_EQ(run_mresim_in(dir.path(), {"run", "pair.toml", "--out", "plain", "--no-plot"}).status,
+            0);
+  const CommandResult r =
+      run_mresim_in(dir.path(), {"run", "pair.toml", "--out", "set", "--no-plot", "--set",
+                                 "field.max=0.5", "--set", "field.step=0.05"});
   ASSERT_EQ(r.status, 0) << r.err;
 
   // The plain run records the file byte for byte and nothing about overrides.
@@ -87,7 +76,9 @@ TEST(CliOverrides, ARunWithSetComputesAndRecordsTheOverriddenFile) {
 
   // The recorded effective file, run as a file of its own, gives the same numbers.
   write_text(dir / "effective.toml", effective);
-  ASSERT_EQ(mresim(dir.path(), {"run", "effective.toml", "--out", "again", "--no-plot"}).status, 0);
+  ASSERT_EQ(
+      run_mresim_in(dir.path(), {"run", "effective.toml", "--out", "again", "--no-plot"}).status,
+      0);
   const Hdf5Reader again(dir / "again" / "results.h5");
   EXPECT_EQ(again.doubles("/cases/0/field"), set_field);
   EXPECT_EQ(again.doubles("/cases/0/separation"), set.doubles("/cases/0/separation"));
@@ -96,36 +87,41 @@ TEST(CliOverrides, ARunWithSetComputesAndRecordsTheOverriddenFile) {
 TEST(CliOverrides, InfoShowsWhatAnOverrideGives) {
   const TempDir dir;
   fs::copy_file(kExample, dir / "pair.toml");
-  const Result r = mresim(dir.path(), {"info", "pair.toml", "--set", "springs.k=0.05"});
+  const CommandResult r =
+      run_mresim_in(dir.path(), {"info", "pair.toml", "--set", "springs.k=0.05"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("overrides  springs.k=0.05"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("0.05 N/m"), std::string::npos) << r.out;
-  const Result plain = mresim(dir.path(), {"info", "pair.toml"});
+  const CommandResult plain = run_mresim_in(dir.path(), {"info", "pair.toml"});
   EXPECT_EQ(plain.out.find("overrides"), std::string::npos) << plain.out;
 }
 
 TEST(CliOverrides, BadOverridesExitWith2AndWriteNothing) {
   const TempDir dir;
   fs::copy_file(kExample, dir / "pair.toml");
-  const Result range = mresim(dir.path(), {"run", "pair.toml", "--set", "field.max=-1"});
+  const CommandResult range =
+      run_mresim_in(dir.path(), {"run", "pair.toml", "--set", "field.max=-1"});
   EXPECT_EQ(range.status, 2);
   EXPECT_EQ(range.err, "mresim: error: field.max = -1: must be > 0 (T)\n");
-  const Result unknown = mresim(dir.path(), {"run", "pair.toml", "--set", "field.maxx=1"});
+  const CommandResult unknown =
+      run_mresim_in(dir.path(), {"run", "pair.toml", "--set", "field.maxx=1"});
   EXPECT_EQ(unknown.status, 2);
   EXPECT_EQ(unknown.err,
             "mresim: error: unknown key 'field.maxx' in [field]; allowed keys: angle, max, step\n");
-  const Result parent = mresim(dir.path(), {"run", "pair.toml", "--set", "field.max.x=1"});
+  const CommandResult parent =
+      run_mresim_in(dir.path(), {"run", "pair.toml", "--set", "field.max.x=1"});
   EXPECT_EQ(parent.status, 2);
   EXPECT_EQ(parent.err,
             "mresim: error: --set: field.max.x=1: field.max = 1.0 is a float, not a "
             "table\n");
   // Malformed: refused while the command line is parsed, before the file is read.
-  const Result form = mresim(dir.path(), {"run", "absent.toml", "--set", "fieldmax"});
+  const CommandResult form = run_mresim_in(dir.path(), {"run", "absent.toml", "--set", "fieldmax"});
   EXPECT_EQ(form.status, 2);
   EXPECT_EQ(form.err.rfind("mresim: error: --set: fieldmax: expected KEY=VALUE", 0), 0U)
       << form.err;
   // One argument per --set: FILE after it is not swallowed.
-  const Result order = mresim(dir.path(), {"info", "--set", "field.max=0.5", "pair.toml"});
+  const CommandResult order =
+      run_mresim_in(dir.path(), {"info", "--set", "field.max=0.5", "pair.toml"});
   EXPECT_EQ(order.status, 0) << order.err;
   std::vector<std::string> names;
   for (const auto& e : fs::directory_iterator(dir.path())) names.push_back(e.path().filename());
@@ -140,7 +136,7 @@ TEST(CliOverrides, AResumedRunKeepsTheOverrides) {
   const std::vector<std::string> set = {"--set", "field.max=0.1", "--set", "run.title=small"};
   std::vector<std::string> full = {"run", "run.toml", "--out", "full", "--no-plot", "-j", "2"};
   full.insert(full.end(), set.begin(), set.end());
-  ASSERT_EQ(mresim(dir.path(), full).status, 0);
+  ASSERT_EQ(run_mresim_in(dir.path(), full).status, 0);
 
   std::vector<std::string> stopped = {"run", "run.toml", "--out", "stopped", "--no-plot"};
   stopped.insert(stopped.end(), set.begin(), set.end());
@@ -153,7 +149,8 @@ TEST(CliOverrides, AResumedRunKeepsTheOverrides) {
   ::kill(pid, SIGTERM);  // at once: a small loop ends well within a second
   ASSERT_EQ(mresim::testing::wait_child(pid), 143) << read_text(dir / ".stderr-bg");
 
-  const Result resumed = mresim(dir.path(), {"resume", "stopped", "--no-plot", "-j", "2"});
+  const CommandResult resumed =
+      run_mresim_in(dir.path(), {"resume", "stopped", "--no-plot", "-j", "2"});
   ASSERT_EQ(resumed.status, 0) << resumed.err;
   EXPECT_NE(resumed.err.find("resuming at step"), std::string::npos) << resumed.err;
   EXPECT_EQ(resumed.err.find("warning"), std::string::npos) << resumed.err;

@@ -21,38 +21,22 @@
 namespace {
 
 namespace fs = std::filesystem;
+using mresim::testing::CommandResult;
 using mresim::testing::read_text;
 using mresim::testing::TempDir;
 using mresim::testing::write_text;
 
-struct Result {
-  int status = -1;
-  std::string out;
-  std::string err;
-};
-
-// `program args...` in `dir`, stdout and stderr captured in files (not a terminal).
-Result run_in(const fs::path& dir, const char* program, const std::vector<std::string>& args) {
-  const pid_t pid = mresim::testing::start_child(program, args, dir, ".stdout", ".stderr");
-  Result r;
-  r.status = mresim::testing::wait_child(pid);
-  r.out = read_text(dir / ".stdout");
-  r.err = read_text(dir / ".stderr");
-  fs::remove(dir / ".stdout");
-  fs::remove(dir / ".stderr");
-  return r;
+// `mresim_testbed args...` in `dir`, stdout and stderr captured in files (not a terminal).
+CommandResult run_testbed(const fs::path& dir, const std::vector<std::string>& args) {
+  return mresim::testing::run_program(MRESIM_TESTBED_PATH, dir, args);
 }
 
-Result testbed(const fs::path& dir, const std::vector<std::string>& args) {
-  return run_in(dir, MRESIM_TESTBED_PATH, args);
-}
-
-const char* const kDummyRun = "[run]\ntype = \"test_dummy\"\n[dummy]\nsteps = 4\n";
+const char* const kFourStepDummyRun = "[run]\ntype = \"test_dummy\"\n[dummy]\nsteps = 4\n";
 
 TEST(ProgressCli, WithoutATerminalEveryTenPercentIsALine) {
   const TempDir dir;
-  write_text(dir / "demo.toml", kDummyRun);
-  const Result r = testbed(dir.path(), {"run", "demo.toml", "--no-plot"});
+  write_text(dir / "demo.toml", kFourStepDummyRun);
+  const CommandResult r = run_testbed(dir.path(), {"run", "demo.toml", "--no-plot"});
   ASSERT_EQ(r.status, 0) << r.err;
   for (const char* line : {"test_dummy: 25% (1/4), elapsed ", "test_dummy: 50% (2/4), elapsed ",
                            "test_dummy: 75% (3/4), elapsed ", "test_dummy: done 4/4 in "}) {
@@ -63,15 +47,15 @@ TEST(ProgressCli, WithoutATerminalEveryTenPercentIsALine) {
 
 TEST(ProgressCli, QuietPrintsNothingButTheLogHasTheLines) {
   const TempDir dir;
-  write_text(dir / "demo.toml", kDummyRun);
-  const Result quiet = testbed(dir.path(), {"run", "demo.toml", "--no-plot", "--quiet"});
+  write_text(dir / "demo.toml", kFourStepDummyRun);
+  const CommandResult quiet = run_testbed(dir.path(), {"run", "demo.toml", "--no-plot", "--quiet"});
   ASSERT_EQ(quiet.status, 0) << quiet.err;
   EXPECT_EQ(quiet.out, "");
   EXPECT_EQ(quiet.err, "");
   EXPECT_TRUE(fs::exists(dir / "demo" / "results.h5"));
 
-  const Result logged =
-      testbed(dir.path(), {"run", "demo.toml", "--no-plot", "-q", "--log", "run.log"});
+  const CommandResult logged =
+      run_testbed(dir.path(), {"run", "demo.toml", "--no-plot", "-q", "--log", "run.log"});
   ASSERT_EQ(logged.status, 0) << logged.err;
   EXPECT_EQ(logged.err, "");
   const std::string log = read_text(dir / "run.log");
@@ -79,7 +63,8 @@ TEST(ProgressCli, QuietPrintsNothingButTheLogHasTheLines) {
   EXPECT_NE(log.find("test_dummy: done 4/4 in "), std::string::npos) << log;
 
   // Without --quiet the log holds what stderr shows (no terminal: the same lines).
-  const Result both = testbed(dir.path(), {"run", "demo.toml", "--no-plot", "--log", "run.log"});
+  const CommandResult both =
+      run_testbed(dir.path(), {"run", "demo.toml", "--no-plot", "--log", "run.log"});
   ASSERT_EQ(both.status, 0) << both.err;
   EXPECT_EQ(read_text(dir / "run.log"), both.err);
 }
@@ -87,7 +72,7 @@ TEST(ProgressCli, QuietPrintsNothingButTheLogHasTheLines) {
 TEST(ProgressCli, ErrorsReachTheLogAndQuietKeepsThem) {
   const TempDir dir;
   write_text(dir / "bad.toml", "[run]\ntype = \"test_dummy\"\n[dummy]\nsteps = 0\n");
-  const Result r = testbed(dir.path(), {"run", "bad.toml", "-q", "--log", "bad.log"});
+  const CommandResult r = run_testbed(dir.path(), {"run", "bad.toml", "-q", "--log", "bad.log"});
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("mresim: error: "), std::string::npos) << r.err;
   EXPECT_EQ(read_text(dir / "bad.log"), r.err);
@@ -95,23 +80,24 @@ TEST(ProgressCli, ErrorsReachTheLogAndQuietKeepsThem) {
 
 TEST(ProgressCli, LogInsideTheOutputDirectoryOrUnwritableIsRefused) {
   const TempDir dir;
-  write_text(dir / "demo.toml", kDummyRun);
-  const Result inside =
-      testbed(dir.path(), {"run", "demo.toml", "--out", "res", "--log", "res/run.log"});
+  write_text(dir / "demo.toml", kFourStepDummyRun);
+  const CommandResult inside =
+      run_testbed(dir.path(), {"run", "demo.toml", "--out", "res", "--log", "res/run.log"});
   EXPECT_EQ(inside.status, 2);
   EXPECT_NE(inside.err.find("mresim: error: --log 'res/run.log': lies inside the output "
                             "directory 'res'"),
             std::string::npos)
       << inside.err;
-  const Result same = testbed(dir.path(), {"run", "demo.toml", "--log", "./demo/../demo"});
+  const CommandResult same =
+      run_testbed(dir.path(), {"run", "demo.toml", "--log", "./demo/../demo"});
   EXPECT_EQ(same.status, 2) << same.err;
-  const Result missing_dir =
-      testbed(dir.path(), {"run", "demo.toml", "--log", "no/such/dir/run.log"});
+  const CommandResult missing_dir =
+      run_testbed(dir.path(), {"run", "demo.toml", "--log", "no/such/dir/run.log"});
   EXPECT_EQ(missing_dir.status, 2);
   EXPECT_NE(missing_dir.err.find("--log 'no/such/dir/run.log': cannot write it: No such file"),
             std::string::npos)
       << missing_dir.err;
-  const Result empty = testbed(dir.path(), {"run", "demo.toml", "--log", ""});
+  const CommandResult empty = run_testbed(dir.path(), {"run", "demo.toml", "--log", ""});
   EXPECT_EQ(empty.status, 2);
   EXPECT_NE(empty.err.find("--log '': must name a file"), std::string::npos) << empty.err;
   // Nothing was run or written.

@@ -24,6 +24,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using mresim::testing::Hdf5Reader;
+using mresim::testing::listing;
 using mresim::testing::read_text;
 using mresim::testing::TempDir;
 using mresim::testing::write_text;
@@ -46,13 +47,6 @@ bool appears(const fs::path& path) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   return false;
-}
-
-std::vector<std::string> listing(const fs::path& dir) {
-  std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
 }
 
 // Issue: two runs into one --out both printed "results written"; the later replaced the other.

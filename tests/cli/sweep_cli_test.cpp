@@ -18,32 +18,20 @@
 namespace {
 
 namespace fs = std::filesystem;
+using mresim::testing::CommandResult;
 using mresim::testing::Hdf5Reader;
 using mresim::testing::read_text;
 using mresim::testing::TempDir;
 using mresim::testing::write_text;
 
-struct Result {
-  int status = -1;
-  std::string out;
-  std::string err;
-};
-
-Result run_program(const fs::path& program, const fs::path& dir,
-                   const std::vector<std::string>& args) {
-  const pid_t pid =
-      mresim::testing::start_child(program, args, dir, ".stdout-sweep", ".stderr-sweep");
-  Result r;
-  r.status = mresim::testing::wait_child(pid);
-  r.out = read_text(dir / ".stdout-sweep");
-  r.err = read_text(dir / ".stderr-sweep");
-  fs::remove(dir / ".stdout-sweep");
-  fs::remove(dir / ".stderr-sweep");
-  return r;
+// `program args...` in `dir`, waited for; stdout and stderr through .stdout-sweep/.stderr-sweep.
+CommandResult run_sweep_program(const fs::path& program, const fs::path& dir,
+                                const std::vector<std::string>& args) {
+  return mresim::testing::run_program(program, dir, args, "-sweep");
 }
 
-Result mresim(const fs::path& dir, const std::vector<std::string>& args) {
-  return run_program(MRESIM_CLI_PATH, dir, args);
+CommandResult run_mresim_sweep(const fs::path& dir, const std::vector<std::string>& args) {
+  return run_sweep_program(MRESIM_CLI_PATH, dir, args);
 }
 
 // Four points: springs.k x field.angle.
@@ -75,7 +63,8 @@ bool present(const fs::path& p) {
 TEST(CliSweep, RunsEveryPointRecordsItsParametersAndCollects) {
   const TempDir dir;
   write_text(dir / "s.toml", kSweep);
-  const Result r = mresim(dir.path(), {"sweep", "s.toml", "--out", "out", "--jobs", "2"});
+  const CommandResult r =
+      run_mresim_sweep(dir.path(), {"sweep", "s.toml", "--out", "out", "--jobs", "2"});
   ASSERT_EQ(r.status, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("4 point(s): 4 ran, 0 failed"), std::string::npos) << r.out;
   for (const auto& p : kPoints) EXPECT_TRUE(present(dir / "out" / p / "results.h5")) << p;
@@ -98,9 +87,10 @@ TEST(CliSweep, RunsEveryPointRecordsItsParametersAndCollects) {
 TEST(CliSweep, SkipsFinishedPointsWhenRunAgain) {
   const TempDir dir;
   write_text(dir / "s.toml", kSweep);
-  ASSERT_EQ(mresim(dir.path(), {"sweep", "s.toml", "--out", "out", "--index", "1"}).status, 0);
+  ASSERT_EQ(
+      run_mresim_sweep(dir.path(), {"sweep", "s.toml", "--out", "out", "--index", "1"}).status, 0);
   const auto first = fs::last_write_time(dir / "out/point-0001/results.h5");
-  const Result r = mresim(dir.path(), {"sweep", "s.toml", "--out", "out"});
+  const CommandResult r = run_mresim_sweep(dir.path(), {"sweep", "s.toml", "--out", "out"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("4 point(s): 3 ran, 0 failed, 1 already finished (skipped)"),
             std::string::npos)
@@ -111,7 +101,8 @@ TEST(CliSweep, SkipsFinishedPointsWhenRunAgain) {
   std::string other = kSweep;
   other.replace(other.find("60.0"), 4, "30.0");
   write_text(dir / "other.toml", other);
-  const Result refused = mresim(dir.path(), {"sweep", "other.toml", "--out", "out"});
+  const CommandResult refused =
+      run_mresim_sweep(dir.path(), {"sweep", "other.toml", "--out", "out"});
   EXPECT_EQ(refused.status, 2);
   EXPECT_NE(refused.err.find("'out' holds another sweep"), std::string::npos) << refused.err;
 }
@@ -119,11 +110,12 @@ TEST(CliSweep, SkipsFinishedPointsWhenRunAgain) {
 TEST(CliSweep, AFailedPointIsReportedAndTheOthersStillRun) {
   const TempDir dir;
   write_text(dir / "s.toml", kSweep);
-  ASSERT_EQ(mresim(dir.path(), {"sweep", "s.toml", "--out", "out", "--index", "0"}).status, 0);
+  ASSERT_EQ(
+      run_mresim_sweep(dir.path(), {"sweep", "s.toml", "--out", "out", "--index", "0"}).status, 0);
   // Point 2's directory holds a file of the user's: its `mresim run` refuses it (status 2).
   fs::create_directories(dir / "out/point-0002");
   write_text(dir / "out/point-0002/notes.txt", "mine");
-  const Result r = mresim(dir.path(), {"sweep", "s.toml", "--out", "out"});
+  const CommandResult r = run_mresim_sweep(dir.path(), {"sweep", "s.toml", "--out", "out"});
   EXPECT_EQ(r.status, 1) << r.err;
   EXPECT_NE(r.err.find("sweep point 2 (springs.k=0.04, field.angle=0.0) failed with exit status 2"),
             std::string::npos)
@@ -137,7 +129,7 @@ TEST(CliSweep, AFailedPointIsReportedAndTheOthersStillRun) {
   EXPECT_NE(points.find("was not written by mresim"), std::string::npos) << points;
 
   // `mresim collect` lists it too, and a table of the points' results has its row, empty.
-  const Result c = mresim(dir.path(), {"collect", "out"});
+  const CommandResult c = run_mresim_sweep(dir.path(), {"collect", "out"});
   EXPECT_EQ(c.status, 0) << c.err;
   EXPECT_NE(c.out.find("3 point(s) finished (0 with invalid results), 1 failed, 0 not run yet"),
             std::string::npos)
@@ -147,7 +139,8 @@ TEST(CliSweep, AFailedPointIsReportedAndTheOthersStillRun) {
 TEST(CliSweep, IndexRunsExactlyOnePointAndNoCollect) {
   const TempDir dir;
   write_text(dir / "s.toml", kSweep);
-  const Result r = mresim(dir.path(), {"sweep", "s.toml", "--out", "out", "--index", "3"});
+  const CommandResult r =
+      run_mresim_sweep(dir.path(), {"sweep", "s.toml", "--out", "out", "--index", "3"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(present(dir / "out/point-0003/results.h5"));
   for (const char* p : {"point-0000", "point-0001", "point-0002"})
@@ -156,7 +149,7 @@ TEST(CliSweep, IndexRunsExactlyOnePointAndNoCollect) {
   EXPECT_EQ(read_text(dir / "out/logs/point-0003.status"), "0\n");
 
   // collect afterwards lists the three others as pending, with empty cells.
-  ASSERT_EQ(mresim(dir.path(), {"collect", "out"}).status, 0);
+  ASSERT_EQ(run_mresim_sweep(dir.path(), {"collect", "out"}).status, 0);
   const std::string points = read_text(dir / "out/collected_points.csv");
   EXPECT_NE(points.find("\n0,point-0000,pending,,,0.02,0\n"), std::string::npos) << points;
 }
@@ -164,7 +157,8 @@ TEST(CliSweep, IndexRunsExactlyOnePointAndNoCollect) {
 TEST(CliSweep, AnIndexPastTheLastPointIsRefusedAndNothingIsWritten) {
   const TempDir dir;
   write_text(dir / "s.toml", kSweep);
-  const Result r = mresim(dir.path(), {"sweep", "s.toml", "--out", "out", "--index", "4"});
+  const CommandResult r =
+      run_mresim_sweep(dir.path(), {"sweep", "s.toml", "--out", "out", "--index", "4"});
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.err, "mresim: error: --index 4: the sweep has 4 point(s), numbered 0 to 3\n");
   EXPECT_FALSE(present(dir / "out"));
@@ -177,11 +171,11 @@ TEST(CliSweep, TwoMpiRanksCollectTheSameTablesAsOneProcess) {
   if (mpirun.empty() || !present(mpirun)) GTEST_SKIP() << "no MPI launcher (mpirun) found";
   const TempDir dir;
   write_text(dir / "s.toml", kSweep);
-  const Result serial = mresim(dir.path(), {"sweep", "s.toml", "--out", "serial"});
+  const CommandResult serial = run_mresim_sweep(dir.path(), {"sweep", "s.toml", "--out", "serial"});
   ASSERT_EQ(serial.status, 0) << serial.err;
-  const Result mpi = run_program(mpirun, dir.path(),
-                                 {"--allow-run-as-root", "--oversubscribe", "-np", "2",
-                                  MRESIM_CLI_PATH, "sweep", "s.toml", "--out", "mpi"});
+  const CommandResult mpi = run_sweep_program(mpirun, dir.path(),
+                                              {"--allow-run-as-root", "--oversubscribe", "-np", "2",
+                                               MRESIM_CLI_PATH, "sweep", "s.toml", "--out", "mpi"});
   ASSERT_EQ(mpi.status, 0) << mpi.err << mpi.out;
   // Rank 0's summary counts the points of both ranks.
   EXPECT_NE(mpi.out.find("4 point(s): 4 ran, 0 failed"), std::string::npos) << mpi.out;

@@ -8,14 +8,14 @@
 #include <vector>
 
 #include "../support/config_error.hpp"
+#include "../support/toml_text.hpp"
 #include "mresim/config/table_reader.hpp"
 
 namespace mresim::config {
 namespace {
 
-TableReader parse(const std::string& text) { return TableReader::parse_string(text, "test.toml"); }
-
 using mresim::testing::config_error_of;
+using mresim::testing::parse;
 
 // The message of reject_unknown_keys() on `root`, or "" when every key was asked for.
 std::string unknown_of(const TableReader& root) {

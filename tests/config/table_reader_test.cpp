@@ -9,13 +9,13 @@
 #include <string>
 
 #include "../support/config_error.hpp"
+#include "../support/toml_text.hpp"
 
 namespace mresim::config {
 namespace {
 
-TableReader parse(const std::string& text) { return TableReader::parse_string(text, "test.toml"); }
-
 using mresim::testing::config_error_of;
+using mresim::testing::parse;
 
 TEST(TableReaderNumber, AcceptsIntegersAndFloats) {
   const auto root = parse("[model]\nk = 0.04\nn = 3\n");

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <stdexcept>
 
+#include "../support/dissertation_values.hpp"
 #include "mresim/core/constants.hpp"
 #include "mresim/magnetism/loop_features.hpp"
 
@@ -19,7 +20,7 @@ namespace {
 
 // Carbonyl-iron-like parameters of Fig. 1.6.
 constexpr double kChi0 = 70.0;
-constexpr double kMs = 1.6e6;  // A/m
+using mresim::testing::kMs;  // 1.6e6 A/m
 
 }  // namespace
 

@@ -11,38 +11,20 @@
 #include <string>
 #include <thread>
 
+#include "../support/dissertation_values.hpp"
 #include "../support/hdf5_read.hpp"
 #include "../support/temp_dir.hpp"
 #include "mresim/app/run_type.hpp"
 #include "mresim/pair/critical_fields.hpp"
 #include "mresim/pair/stiffness.hpp"
+#include "single_spring_pairs.hpp"
 
 namespace mresim::pair {
 namespace {
 
-constexpr double kR = 1.5e-6;
-
-PairSystem single_spring(double k, PenaltyKind penalty) {
-  PairSystem s;
-  s.springs = {SpringModel::single, k, 0.0, 9e-6};  // the Fig. 2.2 geometry
-  s.penalty = penalty == PenaltyKind::tanh ? OverlapPenalty::tanh_default(kR)
-                                           : OverlapPenalty::wca_default(kR);
-  return s;
-}
-
-// Release field of a clustered pair along the axis at contact distance `contact`: the linear
-// dipole attraction 2 m^2 / s_c^4 equals the spring force k~ (s0 - s_c), m = chi h/(1 - 2 chi a)
-// (units of R and mu0 Ms^2 V; the moments are far below saturation for these soft springs).
-double analytic_release_field(const PairSystem& p, double contact) {
-  const SphereMaterial& mat = p.material;
-  const double sc = contact / mat.radius;
-  const double s0 = p.springs.rest_separation / mat.radius;
-  const double k = p.springs.k12 * mat.radius * mat.radius / mat.magnetic_energy_scale();
-  const double m = std::sqrt(0.5 * k * (s0 - sc) * std::pow(sc, 4));
-  const double a = 1.0 / (3.0 * sc * sc * sc);
-  return m * (1.0 - 2.0 * mat.susceptibility * a) / mat.susceptibility * kMu0 *
-         mat.saturation_magnetization;
-}
+using mresim::pair::testing::analytic_release_field;
+using mresim::pair::testing::single_spring;
+using mresim::testing::kR;
 
 SweepOptions sweep_with(RelaxMethod method) {
   SweepOptions s;
@@ -58,7 +40,7 @@ TEST(TwoDipoleSoftSprings, ReleaseFieldAtTheWcaWallMatchesTheForceBalance) {
   CriticalFieldOptions fine;
   fine.tolerance = 1e-7;
   for (const double k : {2e-3, 1e-5}) {
-    const PairSystem p = single_spring(k, PenaltyKind::wca);
+    const PairSystem p = single_spring(k, 9e-6, PenaltyKind::wca);
     const double expected = analytic_release_field(p, p.penalty.r_cut);
     for (const RelaxMethod method : {RelaxMethod::newton, RelaxMethod::conjugate_gradient}) {
       const CriticalFields cf = critical_fields_of(p, sweep_with(method), fine);
@@ -72,7 +54,7 @@ TEST(TwoDipoleSoftSprings, ReleaseFieldAtTheWcaWallMatchesTheForceBalance) {
 // Defect: for k <= 3e-6 N/m Newton left the pair in contact at zero field and reported
 // H_C1 = -H_C2. At zero field there is no attraction, so the pair must be back at S0.
 TEST(TwoDipoleSoftSprings, PairSeparatesAtZeroFieldAndReleasesAtThePositiveForceBalance) {
-  const PairSystem p = single_spring(3e-6, PenaltyKind::wca);
+  const PairSystem p = single_spring(3e-6, 9e-6, PenaltyKind::wca);
   SweepOptions sweep;
   sweep.first_quadrant_only = true;
   const HysteresisLoop loop = run_hysteresis(p, sweep);
@@ -94,7 +76,7 @@ TEST(TwoDipoleSoftSprings, PairSeparatesAtZeroFieldAndReleasesAtThePositiveForce
 TEST(TwoDipoleSoftSprings, ZeroFieldStateIsAtTheRestSeparationWhateverTheStiffness) {
   for (const double k : {1e-10, 1e-12, 1e-14}) {
     for (const PenaltyKind penalty : {PenaltyKind::tanh, PenaltyKind::wca}) {
-      const PairSystem p = single_spring(k, penalty);
+      const PairSystem p = single_spring(k, 9e-6, penalty);
       const PairState s =
           relax_at_field(p, 0.0, field_direction(0.0), Eigen::Vector3d(3.2e-6, 0.0, 0.0), {});
       EXPECT_TRUE(s.converged) << k;
@@ -110,7 +92,7 @@ TEST(TwoDipoleSoftSprings, CriticalFieldsLieInTheSweptRange) {
   sweep.b_max = 0.5;
   for (const double k : {1e-8, 3e-8, 1e-6, 3e-6, 1e-5, 2e-3}) {
     for (const PenaltyKind penalty : {PenaltyKind::tanh, PenaltyKind::wca}) {
-      const CriticalFields cf = critical_fields_of(single_spring(k, penalty), sweep);
+      const CriticalFields cf = critical_fields_of(single_spring(k, 9e-6, penalty), sweep);
       const std::string what = "k = " + std::to_string(k) +
                                (penalty == PenaltyKind::tanh ? " tanh" : " wca") + ": " +
                                cf.problem;
@@ -240,7 +222,7 @@ TEST(CriticalFieldBisection, EndsWhenTheToleranceIsBelowDoublePrecision) {
   EXPECT_EQ(bisection_limit(0.01, 1e-4), 7);
   EXPECT_LE(bisection_limit(0.01, 1e-300), 1100);
   EXPECT_EQ(bisection_limit(0.01, 0.0), 0);
-  const PairSystem p = single_spring(4e-2, PenaltyKind::tanh);
+  const PairSystem p = single_spring(4e-2, 9e-6, PenaltyKind::tanh);
   auto task = std::make_shared<std::packaged_task<CriticalFields()>>([p] {
     CriticalFieldOptions impossible;
     impossible.tolerance = 1e-30;
@@ -261,11 +243,11 @@ TEST(CriticalFieldBisection, EndsWhenTheToleranceIsBelowDoublePrecision) {
 TEST(CriticalFieldMarking, UnconvergedRelaxationsMarkTheCriticalFields) {
   SweepOptions sweep;
   sweep.relax.max_iterations = 1;
-  const CriticalFields cf = critical_fields_of(single_spring(4e-2, PenaltyKind::tanh), sweep);
+  const CriticalFields cf = critical_fields_of(single_spring(4e-2, 9e-6, PenaltyKind::tanh), sweep);
   EXPECT_FALSE(cf.converged);
   EXPECT_FALSE(cf.valid());
   EXPECT_NE(cf.problem.find("did not converge at B = "), std::string::npos) << cf.problem;
-  const CriticalFields good = critical_fields_of(single_spring(4e-2, PenaltyKind::tanh), {});
+  const CriticalFields good = critical_fields_of(single_spring(4e-2, 9e-6, PenaltyKind::tanh), {});
   EXPECT_TRUE(good.valid()) << good.problem;
 }
 
@@ -277,7 +259,7 @@ namespace {
 using mresim::config::ConfigError;
 using mresim::config::TableReader;
 
-const std::string kMap = R"([run]
+const std::string kTinyToleranceMap = R"([run]
 type = "pair_map"
 [springs]
 model = "single"
@@ -295,7 +277,7 @@ separation_values = [9e-6]
 TEST(CriticalFieldTolerance, BelowWhatDoublesResolveIsRefusedNamingTheKey) {
   std::string message = "(no error)";
   try {
-    mresim::app::make_plan(TableReader::parse_string(kMap, "map.toml"));
+    mresim::app::make_plan(TableReader::parse_string(kTinyToleranceMap, "map.toml"));
   } catch (const ConfigError& e) {
     message = e.what();
   }

@@ -8,6 +8,8 @@
 #include <string>
 
 #include "../support/hdf5_read.hpp"
+#include "../support/run_file_edits.hpp"
+#include "../support/run_plan.hpp"
 #include "../support/temp_dir.hpp"
 #include "mresim/app/run_type.hpp"
 #include "mresim/pair/runs/pair_outputs.hpp"
@@ -16,6 +18,8 @@ namespace {
 
 using mresim::config::ConfigError;
 using mresim::config::TableReader;
+using mresim::testing::edit;
+using mresim::testing::run_file_error_of;
 
 const std::string kLoop = R"([run]
 type = "pair_hysteresis"
@@ -59,21 +63,6 @@ mean = 4.8e-6
 standard_deviation = 6.5e-6
 )";
 
-std::string replaced(std::string text, const std::string& from, const std::string& to) {
-  const auto at = text.find(from);
-  if (at == std::string::npos) throw std::logic_error("no " + from);
-  return text.replace(at, from.size(), to);
-}
-
-std::string error_of(const std::string& text) {
-  try {
-    mresim::app::make_plan(TableReader::parse_string(text, "run.toml"));
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
-
 bool starts_with(const std::string& s, const std::string& prefix) {
   return s.rfind(prefix, 0) == 0;
 }
@@ -88,7 +77,7 @@ void PrintTo(const Refused& r, std::ostream* os) { *os << r.name; }
 class PairScaleErrors : public ::testing::TestWithParam<Refused> {};
 
 TEST_P(PairScaleErrors, AreRefusedNamingTheKey) {
-  const std::string message = error_of(GetParam().text);
+  const std::string message = run_file_error_of(GetParam().text);
   EXPECT_TRUE(starts_with(message, GetParam().prefix)) << message;
 }
 
@@ -102,13 +91,12 @@ INSTANTIATE_TEST_SUITE_P(
         Refused{"TinyRadius", kLoop + "[material]\nradius = 1e-300\n",
                 "material.radius = 1e-300: gives the sphere volume V = 4/3 pi R^3 = 0 m^3"},
         Refused{"FarRestSeparation",
-                replaced(kLoop, "rest_separation = 9e-6", "rest_separation = 1e150"),
+                edit(kLoop, "rest_separation = 9e-6", "rest_separation = 1e150"),
                 "springs.rest_separation = 1e+150: must be <= 1e+100 R = 1.5e+94 m"},
-        Refused{"FarMapSeparation",
-                replaced(kMap, "separation_max = 12e-6", "separation_max = 1e200"),
+        Refused{"FarMapSeparation", edit(kMap, "separation_max = 12e-6", "separation_max = 1e200"),
                 "map.separation_max = 1e+200: every separation must be <= 1e+100 R"},
         Refused{"HugeStiffnessForTinySpheres",
-                replaced(kLoop, "k = 4e-2", "k = 1e300") +
+                edit(kLoop, "k = 4e-2", "k = 1e300") +
                     "[material]\nradius = 1e-100\n[penalty]\ntype = \"wca\"\n",
                 "springs.k = 1e+300: gives the spring constant 1e+300 N/m and the spring energy "
                 "scale k S0^2"},
@@ -117,38 +105,37 @@ INSTANTIATE_TEST_SUITE_P(
         // field.max is bounded in saturation fields before step and tolerance are checked
         // against it (before: exit 1 "coincident sphere centres", or critical_fields.tolerance
         // blamed).
-        Refused{"FieldMaxFarBeyondSaturation", replaced(kLoop, "max = 0.1", "max = 1e308"),
+        Refused{"FieldMaxFarBeyondSaturation", edit(kLoop, "max = 0.1", "max = 1e308"),
                 "field.max = 1e+308: must be <= 1e+06 mu0 Ms = 1.75929e+06 T at Ms = 1.4e+06 "
                 "A/m (the pair is saturated long before; far beyond, the Zeeman energy swamps "
                 "every other term of the solver)"},
         Refused{"FieldMaxBeforeTolerance",
-                replaced(kLoop, "max = 0.1\nstep = 0.01", "max = 1e308\nstep = 1e306") +
+                edit(kLoop, "max = 0.1\nstep = 0.01", "max = 1e308\nstep = 1e306") +
                     "[critical_fields]\ntolerance = 1e-4\n",
                 "field.max = 1e+308: must be <= 1e+06 mu0 Ms"},
         Refused{"FieldMaxJustAboveTheBound",
-                replaced(kLoop, "max = 0.1\nstep = 0.01", "max = 1.8e6\nstep = 1e5"),
+                edit(kLoop, "max = 0.1\nstep = 0.01", "max = 1.8e6\nstep = 1e5"),
                 "field.max = 1800000: must be <= 1e+06 mu0 Ms = 1.75929e+06 T"},
         Refused{"FieldMaxForSmallerMsInACase",
-                replaced(kLoop, "max = 0.1\nstep = 0.01", "max = 1e5\nstep = 1e4") +
+                edit(kLoop, "max = 0.1\nstep = 0.01", "max = 1e5\nstep = 1e4") +
                     "[[case]]\nlabel = \"soft\"\n[case.material]\nsaturation_magnetization = "
                     "1e4\n",
                 "case[0].field.max = 100000: must be <= 1e+06 mu0 Ms = 12566.4 T at Ms = 10000 "
                 "A/m"},
         Refused{"MapFieldMax",
-                replaced(kMap, "max = 0.1\nstep = 0.01", "max = 1e308\nstep = 1e302") +
+                edit(kMap, "max = 0.1\nstep = 0.01", "max = 1e308\nstep = 1e302") +
                     "[critical_fields]\ntolerance = 1e-4\n",
                 "field.max = 1e+308: must be <= 1e+06 mu0 Ms"},
         Refused{"EnsembleFieldMax",
-                replaced(kEnsemble, "max = 0.1\nstep = 0.01", "max = 1e308\nstep = 1e307"),
+                edit(kEnsemble, "max = 0.1\nstep = 0.01", "max = 1e308\nstep = 1e307"),
                 "field.max = 1e+308: must be <= 1e+06 mu0 Ms"},
-        Refused{"EnsembleMeanInMicrometres", replaced(kEnsemble, "mean = 4.8e-6", "mean = 4.8"),
+        Refused{"EnsembleMeanInMicrometres", edit(kEnsemble, "mean = 4.8e-6", "mean = 4.8"),
                 "ensemble.mean = 4.8: the Gaussian weights exp(-(S0 - mean)^2 / (2 sd^2)) with "
                 "mean = 4.8 m, standard_deviation = 6.5e-06 m vanish at every separation from "
                 "3.2e-06 to 1.3e-05 m; mean and standard_deviation are in metres"},
         Refused{"EnsembleWidthFarTooNarrow",
-                replaced(replaced(kEnsemble, "standard_deviation = 6.5e-6",
-                                  "standard_deviation = 1e-9"),
-                         "mean = 4.8e-6", "mean = 5.6e-6"),
+                edit(edit(kEnsemble, "standard_deviation = 6.5e-6", "standard_deviation = 1e-9"),
+                     "mean = 4.8e-6", "mean = 5.6e-6"),
                 "ensemble.standard_deviation = 1e-09: the Gaussian weights"}),
     [](const auto& info) { return info.param.name; });
 
@@ -156,12 +143,12 @@ INSTANTIATE_TEST_SUITE_P(
 // the fix these aborted with status 134 and left out.partial-<pid> behind).
 TEST(PairScaleErrors, CommandLineRefusesThemWithStatus2) {
   const std::vector<std::pair<std::string, std::string>> files{
-      {replaced(kLoop, "rest_separation = 9e-6", "rest_separation = 1e150"),
+      {edit(kLoop, "rest_separation = 9e-6", "rest_separation = 1e150"),
        "mresim: error: springs.rest_separation = 1e+150: "},
       {kLoop + "[material]\nradius = 1e-300\n", "mresim: error: material.radius = 1e-300: "},
-      {replaced(kMap, "separation_max = 12e-6", "separation_max = 1e200"),
+      {edit(kMap, "separation_max = 12e-6", "separation_max = 1e200"),
        "mresim: error: map.separation_max = 1e+200: "},
-      {replaced(kLoop, "max = 0.1\nstep = 0.01", "max = 1e308\nstep = 1e307"),
+      {edit(kLoop, "max = 0.1\nstep = 0.01", "max = 1e308\nstep = 1e307"),
        "mresim: error: field.max = 1e+308: must be <= 1e+06 mu0 Ms"}};
   for (const auto& [text, prefix] : files) {
     const mresim::testing::TempDir dir;
@@ -184,10 +171,10 @@ TEST(PairScaleErrors, CommandLineRefusesThemWithStatus2) {
 // Fig. 2.9's first column, S0 = 3.2 um, lies inside the WCA cut-off 2^(1/6) 2R = 3.367 um: the
 // penalty pushes the pair out. The run says so (stderr and results.h5 /@warnings).
 TEST(PairInputWarnings, RestSeparationInsideTheWcaCutoffIsReported) {
-  const std::string text = replaced(replaced(kLoop, "model = \"single\"\nk = 4e-2",
-                                             "model = \"three\"\n"
-                                             "shear_modulus = 1375"),
-                                    "rest_separation = 9e-6", "rest_separation = 3.2e-6");
+  const std::string text = edit(edit(kLoop, "model = \"single\"\nk = 4e-2",
+                                     "model = \"three\"\n"
+                                     "shear_modulus = 1375"),
+                                "rest_separation = 9e-6", "rest_separation = 3.2e-6");
   const mresim::testing::TempDir dir;
   mresim::testing::write_text(dir / "wca.toml", text);
   const std::string command = "cd '" + dir.path().string() + "' && '" + MRESIM_CLI_PATH +

@@ -4,21 +4,17 @@
 
 #include <algorithm>
 
+#include "../support/dissertation_values.hpp"
 #include "mresim/pair/critical_fields.hpp"
 #include "mresim/pair/stiffness.hpp"
+#include "single_spring_pairs.hpp"
 
 namespace mresim::pair {
 namespace {
 
-constexpr double kR = 1.5e-6;
-
-PairSystem single_spring(double k, double s0, PenaltyKind penalty = PenaltyKind::tanh) {
-  PairSystem s;
-  s.springs = {SpringModel::single, k, 0.0, s0};
-  s.penalty = penalty == PenaltyKind::tanh ? OverlapPenalty::tanh_default(kR)
-                                           : OverlapPenalty::wca_default(kR);
-  return s;
-}
+using mresim::pair::testing::analytic_release_field;
+using mresim::pair::testing::single_spring;
+using mresim::testing::kR;
 
 PairSystem three_spring_puljiz(double shear_modulus, double s0) {
   PairSystem s;
@@ -34,20 +30,6 @@ double min_displacement(const HysteresisLoop& loop, double s0) {
   return lowest;
 }
 
-// The release field of a clustered pair along the field: the clustered state stops being a
-// minimum when the saturated-or-linear dipole attraction at the contact distance s_c (units of
-// R) falls below the spring force, 2 m^2 / s_c^4 = k~ (s0 - s_c), with m = chi h / (1 - 2 chi a).
-double analytic_release_field(const PairSystem& p, double k, double contact) {
-  const SphereMaterial& mat = p.material;
-  const double sc = contact / mat.radius;
-  const double s0 = p.springs.rest_separation / mat.radius;
-  const double k_scaled = k * mat.radius * mat.radius / mat.magnetic_energy_scale();
-  const double m = std::sqrt(0.5 * k_scaled * (s0 - sc) * std::pow(sc, 4));
-  const double a = 1.0 / (3.0 * sc * sc * sc);
-  const double h = m * (1.0 - 2.0 * mat.susceptibility * a) / mat.susceptibility;
-  return h * kMu0 * mat.saturation_magnetization;
-}
-
 // Claim C3, Fig. 2.2: k = 4e-2 N/m, S0 = 9 um, field along the axis, +-1 T in 0.01 T steps.
 TEST(Figure22, AxialFieldClustersToSurfaceContactWithABistableRange) {
   const PairSystem p = single_spring(4e-2, 9e-6);
@@ -58,7 +40,7 @@ TEST(Figure22, AxialFieldClustersToSurfaceContactWithABistableRange) {
   const CriticalFields cf = find_critical_fields(p, loop);
   ASSERT_TRUE(cf.hysteresis);
   EXPECT_LT(cf.hc1, cf.hc2);
-  EXPECT_NEAR(cf.hc1, analytic_release_field(p, 4e-2, 2 * kR), 1e-4);
+  EXPECT_NEAR(cf.hc1, analytic_release_field(p, 2 * kR), 1e-4);
   // Pinched loop: below H_C1 both branches coincide (no remanence).
   for (const PairState& s : loop.states) {
     if (std::abs(s.field) < cf.hc1 - 0.01 && s.branch == 1) {
@@ -117,7 +99,7 @@ TEST(Figure26, WcaGivesLargerMinimumSeparationAndLargerReleaseField) {
   const CriticalFields cf_tanh = find_critical_fields(tanh, loop_tanh);
   const CriticalFields cf_wca = find_critical_fields(wca, loop_wca);
   EXPECT_GT(cf_wca.hc1, cf_tanh.hc1);
-  EXPECT_NEAR(cf_wca.hc1, analytic_release_field(wca, 4e-2, wca.penalty.r_cut), 1e-4);
+  EXPECT_NEAR(cf_wca.hc1, analytic_release_field(wca, wca.penalty.r_cut), 1e-4);
   EXPECT_NEAR(cf_wca.hc2, cf_tanh.hc2, 1e-4);  // clustering happens far from either penalty
 }
 

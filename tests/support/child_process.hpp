@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "temp_dir.hpp"
+
 namespace mresim::testing {
 
 // Starts `program args...` in `dir`; `out` and `err` are created (relative to `dir` unless
@@ -54,6 +56,31 @@ inline int wait_child(pid_t pid) {
   int raw = 0;
   ::waitpid(pid, &raw, 0);
   return exit_status_of_raw(raw);
+}
+
+// What a finished program left: its exit status (or 128 + signal), stdout and stderr.
+struct CommandResult {
+  int status = -1;
+  std::string out;
+  std::string err;
+};
+
+// Runs `program args...` in `dir` and waits for it. stdout and stderr go to the files
+// .stdout<capture_suffix> and .stderr<capture_suffix> in `dir`, read back and removed.
+inline CommandResult run_program(const std::filesystem::path& program,
+                                 const std::filesystem::path& dir,
+                                 const std::vector<std::string>& args,
+                                 const std::string& capture_suffix = "") {
+  const std::string out = ".stdout" + capture_suffix;
+  const std::string err = ".stderr" + capture_suffix;
+  const pid_t pid = start_child(program, args, dir, out, err);
+  CommandResult r;
+  r.status = wait_child(pid);
+  r.out = read_text(dir / out);
+  r.err = read_text(dir / err);
+  std::filesystem::remove(dir / out);
+  std::filesystem::remove(dir / err);
+  return r;
 }
 
 }  // namespace mresim::testing

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "../../support/hdf5_read.hpp"
+#include "../../support/run_plan.hpp"
 #include "../../support/temp_dir.hpp"
 #include "mresim/app/run_type.hpp"
 #include "mresim/core/constants.hpp"
@@ -17,31 +18,11 @@ namespace mresim::magnetism::runs {
 namespace {
 
 using mresim::testing::Hdf5Reader;
+using mresim::testing::info_of;
+using mresim::testing::info_value;
+using mresim::testing::plan_error_of;
+using mresim::testing::plan_of;
 using mresim::testing::TempDir;
-
-std::unique_ptr<app::RunPlan> plan_of(const std::string& tables) {
-  return app::make_plan(config::TableReader::parse_string(
-      "[run]\ntype = \"froehlich_kennelly\"\n" + tables, "test.toml"));
-}
-
-nlohmann::json info_of(const std::string& tables) {
-  app::InfoReport report;
-  plan_of(tables)->describe(report);
-  return report.to_json();
-}
-
-double value(const nlohmann::json& info, const std::string& section, const std::string& key) {
-  return info.at(section).at(key).at("value").get<double>();
-}
-
-std::string error_of(const std::string& tables) {
-  try {
-    (void)plan_of(tables);
-  } catch (const config::ConfigError& e) {
-    return e.what();
-  }
-  return "no error";
-}
 
 // Eq. 1.5 for the applied field B = mu0 H, written out independently of the library.
 double fk_m_over_ms(double b, double chi0, double ms) {
@@ -50,33 +31,36 @@ double fk_m_over_ms(double b, double chi0, double ms) {
 }
 
 TEST(FroehlichKennellyRun, DefaultsAreFigure16) {
-  const nlohmann::json info = info_of("");
-  EXPECT_DOUBLE_EQ(value(info, "material", "susceptibility"), 70.0);
-  EXPECT_DOUBLE_EQ(value(info, "material", "saturation_magnetization"), 1.6e6);
-  EXPECT_DOUBLE_EQ(value(info, "field", "max"), 1.0);
-  EXPECT_DOUBLE_EQ(value(info, "field", "step"), 0.01);
+  const nlohmann::json info = info_of("froehlich_kennelly", "");
+  EXPECT_DOUBLE_EQ(info_value(info, "material", "susceptibility"), 70.0);
+  EXPECT_DOUBLE_EQ(info_value(info, "material", "saturation_magnetization"), 1.6e6);
+  EXPECT_DOUBLE_EQ(info_value(info, "field", "max"), 1.0);
+  EXPECT_DOUBLE_EQ(info_value(info, "field", "step"), 0.01);
   EXPECT_EQ(info["field"]["steps_per_branch"]["value"].get<long>(), 100);
   EXPECT_EQ(info["field"]["samples"]["value"].get<long>(), 501);
 }
 
 TEST(FroehlichKennellyRun, DescribesDerivedQuantitiesInClosedForm) {
-  const nlohmann::json info = info_of(
-      "[material]\nsusceptibility = 50\nsaturation_magnetization = 1.2e6\n"
-      "[field]\nmax = 0.5\nstep = 0.005\n");
+  const nlohmann::json info =
+      info_of("froehlich_kennelly",
+              "[material]\nsusceptibility = 50\nsaturation_magnetization = 1.2e6\n"
+              "[field]\nmax = 0.5\nstep = 0.005\n");
   EXPECT_EQ(info["field"]["steps_per_branch"]["value"].get<long>(), 100);
   EXPECT_EQ(info["field"]["samples"]["value"].get<long>(), 501);
   const double h = 0.5 / kMu0;  // 397887 A/m
-  EXPECT_NEAR(value(info, "derived", "H_at_field_max"), h, 1e-9 * h);
-  EXPECT_NEAR(value(info, "derived", "M_over_Ms_at_field_max"), 50 * h / (1.2e6 + 50 * h), 1e-14);
+  EXPECT_NEAR(info_value(info, "derived", "H_at_field_max"), h, 1e-9 * h);
+  EXPECT_NEAR(info_value(info, "derived", "M_over_Ms_at_field_max"), 50 * h / (1.2e6 + 50 * h),
+              1e-14);
   // M = Ms/2 at chi0 H = Ms: H = 24000 A/m, B = mu0 H = 0.030159 T.
-  EXPECT_NEAR(value(info, "derived", "half_saturation_H"), 24000.0, 1e-9);
-  EXPECT_NEAR(value(info, "derived", "half_saturation_B"), 0.0301593, 1e-7);
-  EXPECT_NEAR(fk_m_over_ms(value(info, "derived", "half_saturation_B"), 50, 1.2e6), 0.5, 1e-12);
+  EXPECT_NEAR(info_value(info, "derived", "half_saturation_H"), 24000.0, 1e-9);
+  EXPECT_NEAR(info_value(info, "derived", "half_saturation_B"), 0.0301593, 1e-7);
+  EXPECT_NEAR(fk_m_over_ms(info_value(info, "derived", "half_saturation_B"), 50, 1.2e6), 0.5,
+              1e-12);
 }
 
 TEST(FroehlichKennellyRun, WritesCurveToCsvAndHdf5) {
   TempDir dir;
-  const auto plan = plan_of("[field]\nmax = 0.5\nstep = 0.005\n");
+  const auto plan = plan_of("froehlich_kennelly", "[field]\nmax = 0.5\nstep = 0.005\n");
   {
     io::Hdf5File results(dir / "results.h5");
     app::Progress progress(0, "test", {nullptr, false, 0.5});
@@ -141,45 +125,47 @@ TEST(FroehlichKennellyRun, WritesCurveToCsvAndHdf5) {
 }
 
 TEST(FroehlichKennellyRun, RejectsInvalidInput) {
-  EXPECT_EQ(error_of("[material]\nsusceptibility = 0\n"),
+  EXPECT_EQ(plan_error_of("froehlich_kennelly", "[material]\nsusceptibility = 0\n"),
             "material.susceptibility = 0: must be > 0");
-  EXPECT_EQ(error_of("[material]\nsusceptibility = -70\n"),
+  EXPECT_EQ(plan_error_of("froehlich_kennelly", "[material]\nsusceptibility = -70\n"),
             "material.susceptibility = -70: must be > 0");
-  EXPECT_EQ(error_of("[material]\nsaturation_magnetization = 0\n"),
+  EXPECT_EQ(plan_error_of("froehlich_kennelly", "[material]\nsaturation_magnetization = 0\n"),
             "material.saturation_magnetization = 0: must be > 0 (A/m)");
-  EXPECT_EQ(error_of("[field]\nstep = 0\n"), "field.step = 0: must be > 0 (T)");
-  EXPECT_EQ(error_of("[field]\nmax = -1\n"), "field.max = -1: must be > 0 (T)");
-  EXPECT_EQ(error_of("[field]\nmax = 0.105\nstep = 0.01\n"),
+  EXPECT_EQ(plan_error_of("froehlich_kennelly", "[field]\nstep = 0\n"),
+            "field.step = 0: must be > 0 (T)");
+  EXPECT_EQ(plan_error_of("froehlich_kennelly", "[field]\nmax = -1\n"),
+            "field.max = -1: must be > 0 (T)");
+  EXPECT_EQ(plan_error_of("froehlich_kennelly", "[field]\nmax = 0.105\nstep = 0.01\n"),
             "field.max = 0.105: must be a whole number of field.step = 0.01 T (the sweep visits "
             "0, +max, -max exactly)");
-  EXPECT_EQ(error_of("[field]\nmax = 1.0\nstep = 1e-7\n"),
+  EXPECT_EQ(plan_error_of("froehlich_kennelly", "[field]\nmax = 1.0\nstep = 1e-7\n"),
             "field.step = 1e-07: must give at most 1e6 steps up to field.max");
-  EXPECT_EQ(error_of("[material]\nsusceptibilty = 70\n"),
+  EXPECT_EQ(plan_error_of("froehlich_kennelly", "[material]\nsusceptibilty = 70\n"),
             "unknown key 'material.susceptibilty' in [material]; allowed keys: "
             "saturation_magnetization, susceptibility");
-  EXPECT_EQ(error_of("[material]\nsusceptibility = \"70\"\n"),
+  EXPECT_EQ(plan_error_of("froehlich_kennelly", "[material]\nsusceptibility = \"70\"\n"),
             "material.susceptibility = \"70\": expected a number");
-  EXPECT_EQ(error_of("[preisach]\nrelays = 10\n"),
+  EXPECT_EQ(plan_error_of("froehlich_kennelly", "[preisach]\nrelays = 10\n"),
             "unknown table [preisach]; allowed: field, material, run");
 }
 
 // Values whose products in eq. 1.5 (chi0 H Ms, H = B / mu0) overflow: before the fix these ran
 // and wrote B_T = inf, M_over_Ms = NaN with only a warning.
 TEST(FroehlichKennellyRun, RejectsParametersThatOverflowEquation15) {
-  EXPECT_EQ(error_of("[field]\nmax = 1e308\nstep = 1e302\n"),
+  EXPECT_EQ(plan_error_of("froehlich_kennelly", "[field]\nmax = 1e308\nstep = 1e302\n"),
             "field.max = 1e+308: must be <= 1e+100 T (H = B / mu0 and the products of eq. 1.5 "
             "must stay finite)");
-  EXPECT_EQ(error_of("[material]\nsaturation_magnetization = 1e308\n"),
+  EXPECT_EQ(plan_error_of("froehlich_kennelly", "[material]\nsaturation_magnetization = 1e308\n"),
             "material.saturation_magnetization = 1e+308: must be <= 1e+60 A/m (eq. 1.5 "
             "multiplies chi0 H Ms, which would overflow)");
-  EXPECT_EQ(error_of("[material]\nsusceptibility = 1e308\n"),
+  EXPECT_EQ(plan_error_of("froehlich_kennelly", "[material]\nsusceptibility = 1e308\n"),
             "material.susceptibility = 1e+308: must be <= 1e+60 (eq. 1.5 multiplies chi0 H Ms, "
             "which would overflow)");
   // The bounds themselves still give a finite curve.
   TempDir dir;
-  const auto plan = plan_of(
-      "[material]\nsusceptibility = 1e60\nsaturation_magnetization = 1e60\n"
-      "[field]\nmax = 1e100\nstep = 1e99\n");
+  const auto plan = plan_of("froehlich_kennelly",
+                            "[material]\nsusceptibility = 1e60\nsaturation_magnetization = 1e60\n"
+                            "[field]\nmax = 1e100\nstep = 1e99\n");
   io::Hdf5File results(dir / "results.h5");
   app::Progress progress(0, "test", {nullptr, false, 0.5});
   EXPECT_NO_THROW(plan->execute(dir.path(), results, progress));
@@ -191,7 +177,7 @@ TEST(FroehlichKennellyRun, RejectsParametersThatOverflowEquation15) {
 
 TEST(FroehlichKennellyRun, AcceptsStepsThatDivideMaxUpToRounding) {
   // 0.3 / 0.1 = 2.9999999999999996 in binary: still exactly three steps.
-  const nlohmann::json info = info_of("[field]\nmax = 0.3\nstep = 0.1\n");
+  const nlohmann::json info = info_of("froehlich_kennelly", "[field]\nmax = 0.3\nstep = 0.1\n");
   EXPECT_EQ(info["field"]["steps_per_branch"]["value"].get<long>(), 3);
 }
 

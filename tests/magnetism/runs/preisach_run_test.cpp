@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "../../support/hdf5_read.hpp"
+#include "../../support/run_plan.hpp"
 #include "../../support/temp_dir.hpp"
 #include "mresim/app/run_type.hpp"
 #include "mresim/magnetism/loop_features.hpp"
@@ -19,60 +20,41 @@ namespace mresim::magnetism::runs {
 namespace {
 
 using mresim::testing::Hdf5Reader;
+using mresim::testing::info_of;
+using mresim::testing::info_value;
+using mresim::testing::plan_error_of;
+using mresim::testing::plan_of;
 using mresim::testing::TempDir;
 
-std::unique_ptr<app::RunPlan> plan_of(const std::string& tables) {
-  return app::make_plan(
-      config::TableReader::parse_string("[run]\ntype = \"preisach\"\n" + tables, "test.toml"));
-}
-
-nlohmann::json info_of(const std::string& tables) {
-  app::InfoReport report;
-  plan_of(tables)->describe(report);
-  return report.to_json();
-}
-
-double value(const nlohmann::json& info, const std::string& section, const std::string& key) {
-  return info.at(section).at(key).at("value").get<double>();
-}
-
-std::string error_of(const std::string& tables) {
-  try {
-    (void)plan_of(tables);
-  } catch (const config::ConfigError& e) {
-    return e.what();
-  }
-  return "no error";
-}
-
 TEST(PreisachRun, DefaultsAreFigure15) {
-  const nlohmann::json info = info_of("");
+  const nlohmann::json info = info_of("preisach", "");
   EXPECT_EQ(info["preisach"]["relays"]["value"].get<long>(), 100000);
-  EXPECT_DOUBLE_EQ(value(info, "preisach", "switch_up_mean"), 0.35);
-  EXPECT_DOUBLE_EQ(value(info, "preisach", "switch_down_mean"), -0.35);
-  EXPECT_DOUBLE_EQ(value(info, "preisach", "switch_sd"), 0.2);
-  EXPECT_DOUBLE_EQ(value(info, "preisach", "weight_mean"), 5.0);
-  EXPECT_DOUBLE_EQ(value(info, "preisach", "weight_sd"), 2.5);
-  EXPECT_DOUBLE_EQ(value(info, "preisach", "weight_min"), 0.01);
+  EXPECT_DOUBLE_EQ(info_value(info, "preisach", "switch_up_mean"), 0.35);
+  EXPECT_DOUBLE_EQ(info_value(info, "preisach", "switch_down_mean"), -0.35);
+  EXPECT_DOUBLE_EQ(info_value(info, "preisach", "switch_sd"), 0.2);
+  EXPECT_DOUBLE_EQ(info_value(info, "preisach", "weight_mean"), 5.0);
+  EXPECT_DOUBLE_EQ(info_value(info, "preisach", "weight_sd"), 2.5);
+  EXPECT_DOUBLE_EQ(info_value(info, "preisach", "weight_min"), 0.01);
   EXPECT_EQ(info["preisach"]["seed"]["value"].get<long>(), 1);
-  EXPECT_DOUBLE_EQ(value(info, "field", "max"), 1.0);
+  EXPECT_DOUBLE_EQ(info_value(info, "field", "max"), 1.0);
   EXPECT_EQ(info["field"]["steps_per_branch"]["value"].get<long>(), 100);
   EXPECT_EQ(info["field"]["samples"]["value"].get<long>(), 501);
 }
 
 TEST(PreisachRun, DescribesAnalyticCoercivityAndRemanence) {
-  const nlohmann::json info = info_of("[field]\nmax = 1.5\nstep = 0.01\n");
+  const nlohmann::json info = info_of("preisach", "[field]\nmax = 1.5\nstep = 0.01\n");
   EXPECT_EQ(info["field"]["samples"]["value"].get<long>(), 751);
   // Values of tests/magnetism/preisach_test.cpp: B_c = 0.35006 T (0.35 without the swap of
   // alpha < beta draws), M_r/Ms = 1 - 2 Phi(1.75) (1 - Phi(1.75)) = 0.92313.
-  EXPECT_NEAR(value(info, "derived", "expected_coercive_field"), 0.35006, 2e-5);
+  EXPECT_NEAR(info_value(info, "derived", "expected_coercive_field"), 0.35006, 2e-5);
   const double phi = 0.5 * std::erfc(-1.75 / std::sqrt(2.0));
-  EXPECT_NEAR(value(info, "derived", "expected_remanence"), 1.0 - 2.0 * phi * (1.0 - phi), 1e-14);
+  EXPECT_NEAR(info_value(info, "derived", "expected_remanence"), 1.0 - 2.0 * phi * (1.0 - phi),
+              1e-14);
   // At 1.5 T, alpha ~ N(0.35, 0.2) is 5.75 sd below: saturated.
-  EXPECT_NEAR(value(info, "derived", "expected_up_fraction_at_field_max"), 1.0, 1e-8);
-  EXPECT_NEAR(value(info, "derived", "sampling_noise"), 1.0 / std::sqrt(1e5), 1e-15);
+  EXPECT_NEAR(info_value(info, "derived", "expected_up_fraction_at_field_max"), 1.0, 1e-8);
+  EXPECT_NEAR(info_value(info, "derived", "sampling_noise"), 1.0 / std::sqrt(1e5), 1e-15);
   // P(N(5, 2.5) < 0.01) = Phi(-1.996) = 0.02297.
-  EXPECT_NEAR(value(info, "derived", "clipped_weight_fraction"), 0.02297, 1e-5);
+  EXPECT_NEAR(info_value(info, "derived", "clipped_weight_fraction"), 0.02297, 1e-5);
 }
 
 TEST(PreisachRun, ExpectationFollowsTheSwitchingFieldMeans) {
@@ -88,8 +70,8 @@ TEST(PreisachRun, ExpectationFollowsTheSwitchingFieldMeans) {
 
 TEST(PreisachRun, WritesTheLoopOfPreisachLoop) {
   TempDir dir;
-  const auto plan =
-      plan_of("[preisach]\nrelays = 20000\nseed = 7\n[field]\nmax = 1.5\nstep = 0.05\n");
+  const auto plan = plan_of(
+      "preisach", "[preisach]\nrelays = 20000\nseed = 7\n[field]\nmax = 1.5\nstep = 0.05\n");
   {
     io::Hdf5File results(dir / "results.h5");
     app::Progress progress(0, "test", {nullptr, false, 0.5});
@@ -142,6 +124,7 @@ TEST(PreisachRun, MinorLoopWithoutSwitchingGivesNaNFeatures) {
   // The run must still succeed, writing NaN for both features.
   TempDir dir;
   const auto plan = plan_of(
+      "preisach",
       "[preisach]\nrelays = 1000\nswitch_up_mean = 5\nswitch_down_mean = 3\nswitch_sd = 0.1\n"
       "[field]\nmax = 0.01\nstep = 0.01\n");
   {
@@ -158,28 +141,36 @@ TEST(PreisachRun, MinorLoopWithoutSwitchingGivesNaNFeatures) {
 }
 
 TEST(PreisachRun, RejectsInvalidInput) {
-  EXPECT_EQ(error_of("[preisach]\nrelays = 0\n"), "preisach.relays = 0: must be in [1, 100000000]");
-  EXPECT_EQ(error_of("[preisach]\nrelays = 2.5\n"), "preisach.relays = 2.5: expected an integer");
-  EXPECT_EQ(error_of("[preisach]\nswitch_sd = -0.2\n"),
+  EXPECT_EQ(plan_error_of("preisach", "[preisach]\nrelays = 0\n"),
+            "preisach.relays = 0: must be in [1, 100000000]");
+  EXPECT_EQ(plan_error_of("preisach", "[preisach]\nrelays = 2.5\n"),
+            "preisach.relays = 2.5: expected an integer");
+  EXPECT_EQ(plan_error_of("preisach", "[preisach]\nswitch_sd = -0.2\n"),
             "preisach.switch_sd = -0.2: must be > 0 (T)");
-  EXPECT_EQ(error_of("[preisach]\nswitch_sd = 0\n"), "preisach.switch_sd = 0: must be > 0 (T)");
-  EXPECT_EQ(error_of("[preisach]\nweight_mean = 0\n"), "preisach.weight_mean = 0: must be > 0");
-  EXPECT_EQ(error_of("[preisach]\nweight_sd = -1\n"), "preisach.weight_sd = -1: must be >= 0");
-  EXPECT_EQ(error_of("[preisach]\nweight_min = 0\n"), "preisach.weight_min = 0: must be > 0");
-  EXPECT_EQ(error_of("[preisach]\nseed = -1\n"), "preisach.seed = -1: must be >= 0");
-  EXPECT_EQ(error_of("[preisach]\nseed = 1.0\n"), "preisach.seed = 1.0: expected an integer");
-  EXPECT_EQ(error_of("[preisach]\nswitch_up_mean = \"0.35\"\n"),
+  EXPECT_EQ(plan_error_of("preisach", "[preisach]\nswitch_sd = 0\n"),
+            "preisach.switch_sd = 0: must be > 0 (T)");
+  EXPECT_EQ(plan_error_of("preisach", "[preisach]\nweight_mean = 0\n"),
+            "preisach.weight_mean = 0: must be > 0");
+  EXPECT_EQ(plan_error_of("preisach", "[preisach]\nweight_sd = -1\n"),
+            "preisach.weight_sd = -1: must be >= 0");
+  EXPECT_EQ(plan_error_of("preisach", "[preisach]\nweight_min = 0\n"),
+            "preisach.weight_min = 0: must be > 0");
+  EXPECT_EQ(plan_error_of("preisach", "[preisach]\nseed = -1\n"),
+            "preisach.seed = -1: must be >= 0");
+  EXPECT_EQ(plan_error_of("preisach", "[preisach]\nseed = 1.0\n"),
+            "preisach.seed = 1.0: expected an integer");
+  EXPECT_EQ(plan_error_of("preisach", "[preisach]\nswitch_up_mean = \"0.35\"\n"),
             "preisach.switch_up_mean = \"0.35\": expected a number (T)");
-  EXPECT_EQ(error_of("[preisach]\nrelais = 100\n"),
+  EXPECT_EQ(plan_error_of("preisach", "[preisach]\nrelais = 100\n"),
             "unknown key 'preisach.relais' in [preisach]; allowed keys: relays, seed, "
             "switch_down_mean, switch_sd, switch_up_mean, weight_mean, weight_min, weight_sd");
-  EXPECT_EQ(error_of("[field]\nstep = 0\n"), "field.step = 0: must be > 0 (T)");
-  EXPECT_EQ(error_of("[field]\nmax = 1.5\nstep = 0.04\n"),
+  EXPECT_EQ(plan_error_of("preisach", "[field]\nstep = 0\n"), "field.step = 0: must be > 0 (T)");
+  EXPECT_EQ(plan_error_of("preisach", "[field]\nmax = 1.5\nstep = 0.04\n"),
             "field.max = 1.5: must be a whole number of field.step = 0.04 T (the sweep visits "
             "0, +max, -max exactly)");
-  EXPECT_EQ(error_of("[material]\nsusceptibility = 70\n"),
+  EXPECT_EQ(plan_error_of("preisach", "[material]\nsusceptibility = 70\n"),
             "unknown table [material]; allowed: field, preisach, run");
-  EXPECT_EQ(error_of("[field]\nmax = 1e308\nstep = 1e302\n"),
+  EXPECT_EQ(plan_error_of("preisach", "[field]\nmax = 1e308\nstep = 1e302\n"),
             "field.max = 1e+308: must be <= 1e+100 T (H = B / mu0 and the products of eq. 1.5 "
             "must stay finite)");
 }

@@ -21,7 +21,8 @@ constexpr double kSecond = 9500.0;  // Pa, the clustered branch after the kink
 constexpr double kSlope = -120.0;   // J/m^3, b of the second branch
 constexpr double kOffset = -35.0;   // J/m^3, c of the second branch
 
-std::vector<double> strains(int count) {
+// The strains 0, 0.01, 0.02, ... (`count` of them).
+std::vector<double> percent_strains(int count) {
   std::vector<double> x;
   for (int i = 0; i < count; ++i) x.push_back(0.01 * i);
   return x;
@@ -42,7 +43,7 @@ std::vector<double> kinked(const std::vector<double>& x, std::size_t kink) {
 }  // namespace
 
 TEST(MessSecondFit, RecoversTheBranchAfterTheKinkExactly) {
-  const auto x = strains(11);  // 0 ... 0.1, kink at 0.03 as in Fig. 4.27
+  const auto x = percent_strains(11);  // 0 ... 0.1, kink at 0.03 as in Fig. 4.27
   const auto u = kinked(x, 3);
   const ma::QuadraticFit first = ma::fit_energy_density(x, u);
   ASSERT_TRUE(first.valid) << first.problem;
@@ -63,7 +64,7 @@ TEST(MessSecondFit, RecoversTheBranchAfterTheKinkExactly) {
 TEST(MessSecondFit, FollowsTheDroppedZeroPoint) {
   // Shear: the zero-strain point above the next one is dropped (first = 1); the kink point is
   // then first + points of the first fit.
-  const auto x = strains(10);
+  const auto x = percent_strains(10);
   auto u = kinked(x, 5);
   u[0] = u[1] + 1.0;
   const ma::QuadraticFit first = ma::fit_energy_density(x, u);
@@ -78,7 +79,7 @@ TEST(MessSecondFit, FollowsTheDroppedZeroPoint) {
 }
 
 TEST(MessSecondFit, NoKinkNoSecondFit) {
-  const auto x = strains(8);
+  const auto x = percent_strains(8);
   std::vector<double> u;
   for (double xi : x) u.push_back(0.5 * kFirst * xi * xi);
   const ma::QuadraticFit first = ma::fit_energy_density(x, u);
@@ -93,7 +94,7 @@ TEST(MessSecondFit, NoKinkNoSecondFit) {
 }
 
 TEST(MessSecondFit, TwoPointsAfterTheKinkAreUndetermined) {
-  const auto x = strains(6);
+  const auto x = percent_strains(6);
   const auto u = kinked(x, 4);  // points 4 and 5 after the kink
   const ma::QuadraticFit first = ma::fit_energy_density(x, u);
   ASSERT_TRUE(first.split);
@@ -107,7 +108,7 @@ TEST(MessSecondFit, TwoPointsAfterTheKinkAreUndetermined) {
 
 TEST(MessSecondFit, ThreePointsInterpolateAndAreNotAResult) {
   // Three points fix a, b, c exactly (the numbers are right) but check nothing.
-  const auto x = strains(7);
+  const auto x = percent_strains(7);
   const auto u = kinked(x, 4);
   const ma::QuadraticFit first = ma::fit_energy_density(x, u);
   ASSERT_TRUE(first.split);
@@ -120,7 +121,7 @@ TEST(MessSecondFit, ThreePointsInterpolateAndAreNotAResult) {
 }
 
 TEST(MessSecondFit, UnconvergedPointAfterTheKinkIsInvalid) {
-  const auto x = strains(11);
+  const auto x = percent_strains(11);
   const auto u = kinked(x, 3);
   ma::FitOptions options;
   options.converged.assign(x.size(), true);
@@ -134,7 +135,7 @@ TEST(MessSecondFit, UnconvergedPointAfterTheKinkIsInvalid) {
 }
 
 TEST(MessSecondFit, NonFinitePointIsInvalid) {
-  const auto x = strains(11);
+  const auto x = percent_strains(11);
   auto u = kinked(x, 3);
   const ma::QuadraticFit first = ma::fit_energy_density(x, u);
   u[9] = std::numeric_limits<double>::quiet_NaN();
@@ -145,7 +146,7 @@ TEST(MessSecondFit, NonFinitePointIsInvalid) {
 
 TEST(MessSecondFit, NegativeCurvatureIsInvalid) {
   // A concave branch after the kink (the clustered state softening further) is no modulus.
-  const auto x = strains(9);
+  const auto x = percent_strains(9);
   auto u = kinked(x, 4);
   for (std::size_t i = 4; i < x.size(); ++i) u[i] = -0.5 * 3000.0 * x[i] * x[i] - 10.0;
   const ma::QuadraticFit first = ma::fit_energy_density(x, u);

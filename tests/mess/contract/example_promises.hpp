@@ -5,6 +5,7 @@
 // of a run of that example. The evaluator knows nothing about any one example: every number
 // lives in the data file.
 
+#include <fmt/format.h>
 #include <hdf5.h>
 
 #include <cmath>
@@ -186,8 +187,8 @@ inline double quantity(const RunData& r, const nlohmann::json& check, std::size_
 }
 
 inline std::string describe(const nlohmann::json& check) {
-  return "[" + check.value("claim", std::string("?")) + "] " + check.at("quantity").dump() +
-         " at " + check.at("at").dump();
+  return fmt::format("[{}] {} at {}", check.value("claim", std::string("?")),
+                     check.at("quantity").dump(), check.at("at").dump());
 }
 
 // Failures of one check (empty when it holds). Forms: min/max bounds, or equals, on the value

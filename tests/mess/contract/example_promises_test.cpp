@@ -19,22 +19,19 @@
 #include <string>
 #include <vector>
 
+#include "../../support/json_file.hpp"
 #include "../../support/temp_dir.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 namespace pr = mresim::testing::promises;
+using mresim::testing::read_json;
 using nlohmann::json;
 
 const fs::path kSource = MRESIM_SOURCE_DIR;
 const fs::path kDataDir = kSource / "tests/data/examples";
 const fs::path kExampleDir = kSource / "examples/chapter4/small";
-
-json read_json(const fs::path& file) {
-  std::ifstream in(file);
-  return json::parse(in);
-}
 
 // The data files' stems, those marked "slow" or the others.
 std::vector<std::string> data_files(bool slow) {

@@ -43,7 +43,7 @@ mess::MessSystem loaded_pair(const mess::ModelProfile& profile) {
   return system;
 }
 
-void expect_matches_single_process(const mess::ModelProfile& profile) {
+void expect_system_matches_single_process(const mess::ModelProfile& profile) {
   SCOPED_TRACE(std::string(profile.name) + " profile");
   mess::MessSystem single = loaded_pair(profile);
   (void)single.solve_magnetization();  // the same history for both
@@ -84,8 +84,8 @@ void expect_matches_single_process(const mess::ModelProfile& profile) {
 }  // namespace
 
 TEST(DistributedSystem, EvaluationMatchesTheSingleProcessSystem) {
-  expect_matches_single_process(mess::model_profile("physical"));
-  expect_matches_single_process(mess::model_profile("seed"));
+  expect_system_matches_single_process(mess::model_profile("physical"));
+  expect_system_matches_single_process(mess::model_profile("seed"));
 }
 
 TEST(DistributedSystem, RefusesTermsItCannotEvaluate) {

@@ -6,10 +6,12 @@
 #include <set>
 #include <stdexcept>
 
+#include "../../support/dissertation_values.hpp"
+
 namespace mresim::lattice {
 namespace {
 
-constexpr double kR = 1.5e-6;
+using mresim::testing::kR;
 
 TEST(LatticeGrid, ElementLengthIsEquation449) {
   EXPECT_DOUBLE_EQ(element_length(kR, 5), 3e-6 / 11.0);

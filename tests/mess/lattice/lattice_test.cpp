@@ -6,12 +6,13 @@
 #include <cmath>
 #include <numbers>
 
+#include "../../support/dissertation_values.hpp"
 #include "affine_energy.hpp"
 
 namespace mresim::lattice {
 namespace {
 
-constexpr double kE = 9.0e3;
+using mresim::testing::kE;
 
 // Claim D1, Phi = 3 %: 52,200 nodes (30 x 30 x 58), 47,937 cells, assembled.
 TEST(LatticeBuild, PhiThreePercentTwoParticleSystem) {

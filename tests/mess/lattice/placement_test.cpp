@@ -5,11 +5,15 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "../../support/dissertation_values.hpp"
+
 namespace mresim::lattice {
 namespace {
 
-constexpr double kR = 1.5e-6;
-const double kLe = element_length(kR, 5);
+using mresim::testing::kR;
+
+// l_e at n_d = 5, as element_length gives it.
+const double kElementLength = element_length(kR, 5);
 
 double separation_um(const PlacedParticles& p, std::size_t i, std::size_t j) {
   double d2 = 0.0;
@@ -17,7 +21,7 @@ double separation_um(const PlacedParticles& p, std::size_t i, std::size_t j) {
     const double d = p.centre_cells[i][a] - p.centre_cells[j][a];
     d2 += d * d;
   }
-  return std::sqrt(d2) * kLe * 1e6;
+  return std::sqrt(d2) * kElementLength * 1e6;
 }
 
 std::string error_of(const Placement& placement) {
@@ -93,7 +97,7 @@ TEST(LatticePlacement, AnisotropicAndNoisy) {
   r.anisotropy_factor = {1 / std::sqrt(f), 1 / std::sqrt(f), f};
   const PlacedParticles a = place_particles(r, kR, 5);
   const VolumeFractionBox box =
-      box_from_volume_fraction(kR, kLe, 0.02, {2, 2, 2}, r.anisotropy_factor);
+      box_from_volume_fraction(kR, kElementLength, 0.02, {2, 2, 2}, r.anisotropy_factor);
   EXPECT_EQ(a.shape.nodes, box.shape.nodes);
   EXPECT_EQ(a.centre_cells[1][2] - a.centre_cells[0][2], box.spacing_voxels[2]);
   EXPECT_EQ(a.centre_cells[4][0] - a.centre_cells[0][0], box.spacing_voxels[0]);
@@ -137,15 +141,15 @@ TEST(LatticePlacement, ChainsInTheLargeBox) {
   ChainPlacement c;
   c.box = {Eigen::Vector3d(12e-6, 12e-6, 40e-6), BoxRounding::seed_floor_divide};
   c.count = 2;
-  c.separation = 24 * kLe;  // 6.5454 um
+  c.separation = 24 * kElementLength;  // 6.5454 um
   const PlacedParticles two = place_particles(c, kR, 5);
   EXPECT_EQ(two.shape.nodes, (std::array<int, 3>{44, 44, 147}));
   EXPECT_EQ(two.shape.node_count(), 284592);
   EXPECT_EQ(two.shape.cell_count(), 269954);
   EXPECT_NEAR(separation_um(two, 0, 1), 6.5454, 1e-4);
-  const double phi = 2 * sphere_volume(kR) / (43.0 * 43.0 * 146.0 * std::pow(kLe, 3));
+  const double phi = 2 * sphere_volume(kR) / (43.0 * 43.0 * 146.0 * std::pow(kElementLength, 3));
   EXPECT_NEAR(phi, 0.00516, 0.000005);
-  c.separation = 20 * kLe;  // 5.4545 um (Fig. 4.13)
+  c.separation = 20 * kElementLength;  // 5.4545 um (Fig. 4.13)
   EXPECT_NEAR(separation_um(place_particles(c, kR, 5), 0, 1), 5.4545, 1e-4);
   // Four-particle chain, S = 6 um (Fig. 4.20): Phi ~ 1 %.
   c.count = 4;
@@ -153,7 +157,8 @@ TEST(LatticePlacement, ChainsInTheLargeBox) {
   const PlacedParticles four = place_particles(c, kR, 5);
   ASSERT_EQ(four.centre_cells.size(), 4u);
   for (std::size_t i = 1; i < 4; ++i) EXPECT_NEAR(separation_um(four, i - 1, i), 6.0, 1e-9);
-  EXPECT_NEAR(4 * sphere_volume(kR) / (43.0 * 43.0 * 146.0 * std::pow(kLe, 3)), 0.0103, 0.0001);
+  EXPECT_NEAR(4 * sphere_volume(kR) / (43.0 * 43.0 * 146.0 * std::pow(kElementLength, 3)), 0.0103,
+              0.0001);
   // With nearest rounding the same box has 45 x 45 x 148 nodes (12 um = 44 l_e exactly).
   c.box.rounding = BoxRounding::nearest;
   EXPECT_EQ(place_particles(c, kR, 5).shape.nodes, (std::array<int, 3>{45, 45, 148}));
@@ -178,13 +183,13 @@ TEST(LatticePlacement, Helix) {
   EXPECT_EQ(p.shape.node_count(), 993168);
   EXPECT_EQ(p.shape.cell_count(), 959075);
   // Snapped by floor(x/l_e) + 1/2.
-  EXPECT_EQ(p.centre_cells[0][2], static_cast<int>(std::floor(13.5e-6 / kLe)));
+  EXPECT_EQ(p.centre_cells[0][2], static_cast<int>(std::floor(13.5e-6 / kElementLength)));
   for (const double r : {0.5e-6, 1.5e-6, 2.5e-6}) {
     h.radius = r;
     EXPECT_NO_THROW(place_particles(h, kR, 5));
   }
   // The dissertation's "Phi ~ 2 %" does not follow from this box: 8 V_p / V = 0.58 %.
-  EXPECT_NEAR(8 * sphere_volume(kR) / (959075 * std::pow(kLe, 3)), 0.0058, 0.0001);
+  EXPECT_NEAR(8 * sphere_volume(kR) / (959075 * std::pow(kElementLength, 3)), 0.0058, 0.0001);
 }
 
 TEST(LatticePlacement, ByHandSnapsToTheContainingCell) {
@@ -194,7 +199,8 @@ TEST(LatticePlacement, ByHandSnapsToTheContainingCell) {
   const PlacedParticles p = place_particles(b, kR, 5);
   for (std::size_t i = 0; i < 2; ++i) {
     for (int a = 0; a < 3; ++a) {
-      EXPECT_EQ(p.centre_cells[i][a], static_cast<int>(std::floor(b.positions[i][a] / kLe)));
+      EXPECT_EQ(p.centre_cells[i][a],
+                static_cast<int>(std::floor(b.positions[i][a] / kElementLength)));
     }
   }
   EXPECT_EQ(place_particles(ByHandPlacement{b.box, {}}, kR, 5).centre_cells.size(), 0u);
@@ -209,7 +215,8 @@ TEST(LatticePlacement, ErrorsNameTheProblem) {
   EXPECT_NE(e.find("overlap"), std::string::npos) << e;
   EXPECT_NE(e.find("particles 0 and 1"), std::string::npos) << e;
   // Just far enough: 12 voxels (one polymer voxel between the tips).
-  b.positions = {Eigen::Vector3d(5e-6, 5e-6, 11.5 * kLe), Eigen::Vector3d(5e-6, 5e-6, 23.5 * kLe)};
+  b.positions = {Eigen::Vector3d(5e-6, 5e-6, 11.5 * kElementLength),
+                 Eigen::Vector3d(5e-6, 5e-6, 23.5 * kElementLength)};
   EXPECT_EQ(error_of(b), "");
   // Outside the box.
   b.positions = {Eigen::Vector3d(5e-6, 5e-6, 13e-6)};
@@ -225,8 +232,10 @@ TEST(LatticePlacement, ErrorsNameTheProblem) {
   // Noisy regular placement can push particles together or onto the boundary: at a spacing
   // of 13 voxels (one-voxel polymer margin to the faces), two along z, some seeds throw.
   RegularPlacement r{0.0, {1, 1, 2}};
-  r.volume_fraction = sphere_volume(kR) / std::pow(13.2 * kLe, 3);
-  EXPECT_EQ(box_from_volume_fraction(kR, kLe, r.volume_fraction, {1, 1, 2}).spacing_voxels[2], 13);
+  r.volume_fraction = sphere_volume(kR) / std::pow(13.2 * kElementLength, 3);
+  EXPECT_EQ(
+      box_from_volume_fraction(kR, kElementLength, r.volume_fraction, {1, 1, 2}).spacing_voxels[2],
+      13);
   EXPECT_EQ(error_of(r), "");
   r.noisy = true;
   int overlaps = 0;

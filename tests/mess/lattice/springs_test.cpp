@@ -7,13 +7,15 @@
 #include <set>
 #include <tuple>
 
+#include "../../support/dissertation_values.hpp"
 #include "mresim/mess/lattice/lattice.hpp"
 #include "mresim/mess/profile/model_profile.hpp"
 
 namespace mresim::lattice {
 namespace {
 
-constexpr double kLe = 3e-6 / 11.0;
+using mresim::testing::kLe;
+
 const SpringConstants kPolymer{22.0, 6.0, 6.0};
 const SpringConstants kParticle{220000.0, 60000.0, 60000.0};
 

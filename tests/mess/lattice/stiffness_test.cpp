@@ -6,14 +6,16 @@
 #include <limits>
 #include <stdexcept>
 
+#include "../../support/dissertation_values.hpp"
 #include "affine_energy.hpp"
 
 namespace mresim::lattice {
 namespace {
 
-constexpr double kE = 9.0e3;
+using mresim::testing::kE;
+using mresim::testing::kLe;
+
 constexpr double kNu = 0.47;
-constexpr double kLe = 3.0e-6 / 11.0;
 
 // docs/original-code.md#lengths-spring-constants-and-scaling: the original code's constants (A =
 // 1): k_e = 22/35 E l_e, k_c = k_f = 6/35 E l_e, independent of nu.

@@ -8,11 +8,14 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "../../support/dissertation_values.hpp"
+
 namespace mm = mresim::magnetism;
 
 namespace {
 
-constexpr double kR = 1.5e-6;
+using mresim::testing::kR;
+
 const double kV = 4.0 / 3.0 * std::numbers::pi * kR * kR * kR;
 
 // Eq. 4.57 exactly as printed.

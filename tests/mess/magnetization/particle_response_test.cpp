@@ -9,6 +9,7 @@
 #include <Eigen/LU>
 #include <cmath>
 
+#include "../../support/dissertation_values.hpp"
 #include "mresim/core/constants.hpp"
 #include "mresim/magnetism/froehlich_kennelly.hpp"
 
@@ -16,8 +17,9 @@ namespace mm = mresim::magnetism;
 
 namespace {
 
+using mresim::testing::kMs;
+
 constexpr double kChi = 70.0;
-constexpr double kMs = 1.6e6;
 
 // Fields from 1e-6 to 1e3 Ms in a few directions.
 std::vector<Eigen::Vector3d> sample_fields() {

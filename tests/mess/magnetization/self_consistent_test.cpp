@@ -15,6 +15,9 @@
 #include <utility>
 #include <vector>
 
+#include "../../support/dissertation_values.hpp"
+#include "../support/dissertation_particles.hpp"
+#include "../support/mess_test_support.hpp"
 #include "mresim/core/constants.hpp"
 #include "mresim/magnetism/froehlich_kennelly.hpp"
 
@@ -24,21 +27,12 @@ using mm::MagnetizationMethod;
 namespace {
 
 // The dissertation's particles: R = 1.5 um, chi0 = 70, Ms = 1.6e6 A/m.
-const mm::MagneticParticles kParticles{};
-const double kR = kParticles.radius;
-const double kMs = kParticles.Ms;
+using mresim::mess::testing::centres_in_radii;  // columns in units of R
+using mresim::mess::testing::kParticles;
+using mresim::testing::kMs;
+using mresim::testing::kR;
 
-Eigen::Vector3d tesla(double bx, double by, double bz) {
-  return Eigen::Vector3d(bx, by, bz) / mresim::kMu0;  // H_ext = B_ext / mu0
-}
-
-// Columns in units of R.
-Eigen::Matrix3Xd centres_in_radii(std::initializer_list<Eigen::Vector3d> columns) {
-  Eigen::Matrix3Xd c(3, static_cast<Eigen::Index>(columns.size()));
-  int k = 0;
-  for (const Eigen::Vector3d& v : columns) c.col(k++) = v * kR;
-  return c;
-}
+using mresim::mess::testing::tesla;  // H_ext = B_ext / mu0
 
 // A low-symmetry near-contact triple (gaps 0.22 R and 0.12 R, no two bonds aligned, oblique
 // field of 72 mT) found by a search over random triangles: the plain fixed point oscillates
@@ -53,8 +47,7 @@ const Eigen::Matrix3Xd kCrawlTriple =
 const Eigen::Vector3d kCrawlField = tesla(0.015, 0.016, 0.005);
 
 // Well separated particles (>= 3.2 R apart): one solution, fixed point contracts.
-const Eigen::Matrix3Xd kLoose =
-    centres_in_radii({{0.0, 0.0, 0.0}, {3.4, 0.5, -0.3}, {-0.8, 3.3, 1.0}, {1.2, -1.1, 3.5}});
+using mresim::mess::testing::kLoose;
 
 const Eigen::Matrix3Xd kNoHistory;  // 0 columns: start from FK(H_ext)
 

@@ -45,7 +45,8 @@ ProtocolRun run(const std::string& toml) {
   return r;
 }
 
-std::string with(const char* type, const std::string& tables) {
+// The run file of type `type` for the small model, followed by `tables`.
+std::string small_run_file(const char* type, const std::string& tables) {
   return std::string("[run]\ntype = \"") + type + "\"\n" + testing::kSmallModel + tables;
 }
 
@@ -64,7 +65,8 @@ double fitted_modulus(const ProtocolState& state) {
 }
 
 TEST(MessProtocolKinds, MagnetostrictionHoldsOnlyTheBottomAndThePairContracts) {
-  const ProtocolRun r = run(with("mess_magnetostriction", "\n[field]\nmagnitudes = [0.0, 0.1]\n"));
+  const ProtocolRun r =
+      run(small_run_file("mess_magnetostriction", "\n[field]\nmagnitudes = [0.0, 0.1]\n"));
   ASSERT_EQ(r.state.records.size(), 2U);
   const double lz = 17e-6;  // 18 nodes at l_e = 1 um
   EXPECT_NEAR(r.top_face_z[0], lz, 1e-15);
@@ -76,9 +78,10 @@ TEST(MessProtocolKinds, MagnetostrictionHoldsOnlyTheBottomAndThePairContracts) {
 
 TEST(MessProtocolKinds, TensionAndCompressionGiveAnEffectiveYoungsModulus) {
   for (const char* kind : {"tension", "compression"}) {
-    const ProtocolRun r = run(with("mess_strain", std::string("\n[field]\nmagnitudes = [0.0]\n"
-                                                              "\n[strain]\nkind = \"") +
-                                                      kind + "\"\nmax = 0.01\nsteps = 2\n"));
+    const ProtocolRun r =
+        run(small_run_file("mess_strain", std::string("\n[field]\nmagnitudes = [0.0]\n"
+                                                      "\n[strain]\nkind = \"") +
+                                              kind + "\"\nmax = 0.01\nsteps = 2\n"));
     ASSERT_EQ(r.state.records.size(), 3U);
     const double e_eff = fitted_modulus(r.state);
     // Clamped faces stiffen a short block (docs/mess-solvers.md: 1.195 E for a particle-free
@@ -91,9 +94,10 @@ TEST(MessProtocolKinds, TensionAndCompressionGiveAnEffectiveYoungsModulus) {
 }
 
 TEST(MessProtocolKinds, TorsionStoresEnergyQuadraticInTheTwist) {
-  const ProtocolRun r = run(with("mess_strain",
-                                 "\n[field]\nmagnitudes = [0.0]\n"
-                                 "\n[strain]\nkind = \"torsion\"\nmax = 2.0\nsteps = 2\n"));
+  const ProtocolRun r =
+      run(small_run_file("mess_strain",
+                         "\n[field]\nmagnitudes = [0.0]\n"
+                         "\n[strain]\nkind = \"torsion\"\nmax = 2.0\nsteps = 2\n"));
   ASSERT_EQ(r.state.records.size(), 3U);
   const double e1 = r.state.records[1].energies.total();
   const double e2 = r.state.records[2].energies.total();
@@ -103,9 +107,10 @@ TEST(MessProtocolKinds, TorsionStoresEnergyQuadraticInTheTwist) {
 }
 
 TEST(MessProtocolKinds, StressControlledTensionAndShearMeasureTheirStrain) {
-  const ProtocolRun tension = run(with("mess_stress",
-                                       "\n[field]\nmagnitudes = [0.0]\n"
-                                       "\n[stress]\nkind = \"tension\"\nmax = 100.0\nsteps = 2\n"));
+  const ProtocolRun tension =
+      run(small_run_file("mess_stress",
+                         "\n[field]\nmagnitudes = [0.0]\n"
+                         "\n[stress]\nkind = \"tension\"\nmax = 100.0\nsteps = 2\n"));
   ASSERT_EQ(tension.state.records.size(), 3U);
   const double eps = tension.state.records[2].measured_strain;
   EXPECT_GT(eps, 0.0);
@@ -113,9 +118,10 @@ TEST(MessProtocolKinds, StressControlledTensionAndShearMeasureTheirStrain) {
   EXPECT_NEAR(100.0 / eps, tension.youngs_modulus, 0.3 * tension.youngs_modulus);
   EXPECT_NEAR(tension.state.records[1].measured_strain, 0.5 * eps, 0.01 * eps);  // linear
 
-  const ProtocolRun shear = run(with("mess_stress",
-                                     "\n[field]\nmagnitudes = [0.0]\n"
-                                     "\n[stress]\nkind = \"shear\"\nmax = 20.0\nsteps = 1\n"));
+  const ProtocolRun shear =
+      run(small_run_file("mess_stress",
+                         "\n[field]\nmagnitudes = [0.0]\n"
+                         "\n[stress]\nkind = \"shear\"\nmax = 20.0\nsteps = 1\n"));
   ASSERT_EQ(shear.state.records.size(), 2U);
   // A short block held at the bottom and pushed at the top also bends (docs/mess-solvers.md:
   // 0.29 G for a particle-free block): the apparent modulus is below G but positive.

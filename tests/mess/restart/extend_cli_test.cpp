@@ -21,14 +21,14 @@ namespace {
 
 namespace fs = std::filesystem;
 using mresim::mess_protocol::testing::expect_identical_steps;
+using mresim::mess_protocol::testing::kQuiet;
 using mresim::mess_protocol::testing::last_stderr;
 using mresim::mess_protocol::testing::mresim_in;
 using mresim::mess_protocol::testing::small_field_run;
+using mresim::mess_protocol::testing::staged_checkpoint;
 using mresim::testing::Hdf5Reader;
 using mresim::testing::read_text;
 using mresim::testing::TempDir;
-
-const char* const kQuiet = " --no-plot -j 1";
 
 TEST(MessExtendCli, HigherFieldContinuesFromTheFinalStateAsTheDirectRun) {
   const TempDir dir;
@@ -150,17 +150,6 @@ TEST(MessExtendCli, RefusedOverridesNameTheKeyAndLeaveTheRunUntouched) {
   }
 }
 
-// The staging directory of the running extend, once its checkpoint exists.
-fs::path staged_checkpoint(const fs::path& dir) {
-  for (const auto& e : fs::directory_iterator(dir)) {
-    const std::string name = e.path().filename().string();
-    if (name.rfind("out.partial-", 0) == 0 && fs::exists(e.path() / "checkpoint.h5")) {
-      return e.path() / "checkpoint.h5";
-    }
-  }
-  return {};
-}
-
 TEST(MessExtendCli, KilledExtendLeavesTheRunAsItWasAndResumes) {
   const TempDir dir;
   std::ofstream(dir / "run.toml") << small_field_run(0.04, 2, "up");
@@ -179,7 +168,7 @@ TEST(MessExtendCli, KilledExtendLeavesTheRunAsItWasAndResumes) {
   while (std::chrono::steady_clock::now() < deadline) {
     int status = 0;
     if (::waitpid(pid, &status, WNOHANG) == pid) break;  // finished before it could be killed
-    if (!staged_checkpoint(dir.path()).empty()) {
+    if (!staged_checkpoint(dir.path(), "out").empty()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
       ::kill(pid, SIGKILL);
       ::waitpid(pid, &status, 0);

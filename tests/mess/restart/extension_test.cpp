@@ -25,7 +25,7 @@ std::vector<mp::StepSpec> hysteresis_steps(const std::string& field_table) {
                                              field_table));
 }
 
-std::string message_of(const std::function<void()>& f) {
+std::string config_error_message_of(const std::function<void()>& f) {
   try {
     f();
   } catch (const ConfigError& e) {
@@ -62,7 +62,7 @@ TEST(MessExtension, ALargerLoopReplacesTheOldReturnBranch) {
 
 TEST(MessExtension, RefusesPlansThatDropAComputedStepOrAddNone) {
   const auto computed = hysteresis_steps("max = 0.04\nsteps = 2\nsequence = \"up\"\n");
-  EXPECT_NE(message_of([&] {
+  EXPECT_NE(config_error_message_of([&] {
               mp::plan_extension(computed,
                                  hysteresis_steps("max = 0.08\nsteps = 2\nsequence = \"up\"\n"),
                                  "--set field.max=0.08");
@@ -70,7 +70,7 @@ TEST(MessExtension, RefusesPlansThatDropAComputedStepOrAddNone) {
                 .find("extend --set field.max=0.08: the extended protocol has no step with the "
                       "field (0, 0, 0.02) T"),
             std::string::npos);
-  EXPECT_NE(message_of([&] {
+  EXPECT_NE(config_error_message_of([&] {
               mp::plan_extension(computed, computed, "x");
             }).find("adds no field or load value to the 3 computed steps"),
             std::string::npos);
@@ -78,14 +78,14 @@ TEST(MessExtension, RefusesPlansThatDropAComputedStepOrAddNone) {
 
 TEST(MessRestartOverrides, ExtendTakesSequenceKeysRerunSolverKeys) {
   EXPECT_NO_THROW(mp::check_extend_overrides({"field.max=0.1", "strain.values=[0, 0.1]"}));
-  EXPECT_NE(message_of([] {
+  EXPECT_NE(config_error_message_of([] {
               mp::check_extend_overrides({"box.size=[1, 1, 1]"});
             }).find("extend --set box.size=[1, 1, 1]: box.size is not a key that lengthens"),
             std::string::npos);
-  EXPECT_NE(message_of([] { mp::check_extend_overrides({}); }).find("no --set given"),
+  EXPECT_NE(config_error_message_of([] { mp::check_extend_overrides({}); }).find("no --set given"),
             std::string::npos);
   EXPECT_NO_THROW(mp::check_rerun_overrides({"solver.method=newton"}));
-  EXPECT_NE(message_of([] {
+  EXPECT_NE(config_error_message_of([] {
               mp::check_rerun_overrides({"particles.susceptibility=5"});
             }).find("particles.susceptibility is not a solver setting"),
             std::string::npos);

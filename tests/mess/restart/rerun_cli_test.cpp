@@ -15,14 +15,13 @@ namespace {
 
 namespace fs = std::filesystem;
 using mresim::mess_protocol::testing::expect_identical_steps;
+using mresim::mess_protocol::testing::kQuiet;
 using mresim::mess_protocol::testing::last_stderr;
 using mresim::mess_protocol::testing::mresim_in;
 using mresim::mess_protocol::testing::small_field_run;
 using mresim::testing::Hdf5Reader;
 using mresim::testing::read_text;
 using mresim::testing::TempDir;
-
-const char* const kQuiet = " --no-plot -j 1";
 
 // The values of `path` at every step but `skip` (rows of `width` values).
 std::vector<double> without_step(const std::vector<double>& values, std::size_t width,

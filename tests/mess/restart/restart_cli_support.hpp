@@ -1,7 +1,8 @@
 #pragma once
 
-// What the `mresim extend` and `mresim rerun` tests share: small 3D run files, running the
-// command line in a temporary directory, and comparing the step datasets of two runs.
+// What the `mresim extend`, `mresim rerun` and `mresim resume` tests share: small 3D run files,
+// running the command line in a temporary directory, finding a running process's checkpoint,
+// and comparing the step datasets of two runs.
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -26,6 +27,9 @@ inline std::string small_field_run(double max_tesla, int steps, const std::strin
          (node_positions ? "true" : "false") + "\n";
 }
 
+// The options that keep a run of the command line quiet and single-threaded.
+inline const char* const kQuiet = " --no-plot -j 1";
+
 // `mresim ARGS` in `dir`: the exit status; stderr in dir/.stderr.
 inline int mresim_in(const std::filesystem::path& dir, const std::string& args) {
   const std::string command = "cd '" + dir.string() + "' && '" + MRESIM_CLI_PATH + "' " + args +
@@ -36,6 +40,20 @@ inline int mresim_in(const std::filesystem::path& dir, const std::string& args) 
 
 inline std::string last_stderr(const std::filesystem::path& dir) {
   return mresim::testing::read_text(dir / ".stderr");
+}
+
+// The checkpoint in the staging directory (OUT.partial-...) of a running process writing to
+// `dir`/`out`, once it exists; empty before.
+inline std::filesystem::path staged_checkpoint(const std::filesystem::path& dir,
+                                               const std::string& out) {
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind(out + ".partial-", 0) == 0 &&
+        std::filesystem::exists(e.path() / "checkpoint.h5")) {
+      return e.path() / "checkpoint.h5";
+    }
+  }
+  return {};
 }
 
 // The step datasets (everything a step computes; not the wall time) of two runs, bit for bit.

@@ -20,14 +20,13 @@ namespace {
 
 namespace fs = std::filesystem;
 namespace mp = mresim::mess_protocol;
+using mp::testing::kQuiet;
 using mp::testing::kSmallModel;
 using mp::testing::mresim_in;
 using mp::testing::small_field_run;
 using mp::testing::spec_of;
 using mresim::testing::Hdf5Reader;
 using mresim::testing::TempDir;
-
-const char* const kQuiet = " --no-plot -j 1";
 
 // The run file a finished run was made from (results.h5's /@input_toml).
 std::string input_toml_of(const fs::path& run) {

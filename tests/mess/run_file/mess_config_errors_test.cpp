@@ -3,12 +3,15 @@
 
 #include <string>
 
+#include "../../support/run_file_edits.hpp"
+#include "../support/mess_run_file.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
 
 namespace {
 
-using mresim::config::ConfigError;
-using mresim::config::TableReader;
+using mresim::testing::BadInput;
+using mresim::testing::edit;
+using mresim::testing::spec_error_of;
 
 const std::string kValid = R"(
 [run]
@@ -57,39 +60,19 @@ max = 0.1
 steps = 10
 )";
 
-std::string error_of(const std::string& text) {
-  try {
-    (void)mresim::mess_config::read_mess_run_file(TableReader::parse_string(text, "run.toml"));
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
-
-// Replaces the first occurrence of `from` in `text`.
-std::string edit(std::string text, const std::string& from, const std::string& to) {
-  const auto at = text.find(from);
-  if (at == std::string::npos) throw std::logic_error("no " + from);
-  return text.replace(at, from.size(), to);
-}
+// The valid file with the first occurrence of `from` replaced by `to`.
 std::string with(const std::string& from, const std::string& to) { return edit(kValid, from, to); }
 
 TEST(MessConfigRunFile, ValidFilesAreAccepted) {
-  EXPECT_EQ(error_of(kValid), "(no error)");
-  EXPECT_EQ(error_of(kByHand), "(no error)");
-  EXPECT_EQ(error_of(kStrain), "(no error)");
+  EXPECT_EQ(spec_error_of(kValid), "(no error)");
+  EXPECT_EQ(spec_error_of(kByHand), "(no error)");
+  EXPECT_EQ(spec_error_of(kStrain), "(no error)");
 }
-
-struct BadInput {
-  std::string name;
-  std::string text;
-  std::string message;
-};
 
 class MessConfigErrors : public ::testing::TestWithParam<BadInput> {};
 
 TEST_P(MessConfigErrors, NameTheKeyTheValueAndWhatIsAllowed) {
-  EXPECT_EQ(error_of(GetParam().text), GetParam().message);
+  EXPECT_EQ(spec_error_of(GetParam().text), GetParam().message);
 }
 
 INSTANTIATE_TEST_SUITE_P(

@@ -13,7 +13,9 @@
 #include <string>
 
 #include "../../support/hdf5_read.hpp"
+#include "../../support/run_file_edits.hpp"
 #include "../../support/temp_dir.hpp"
+#include "../support/mess_run_file.hpp"
 #include "../support/small_runs.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
 #include "mresim/mess/solvers/minimiser.hpp"
@@ -22,8 +24,10 @@ namespace {
 
 namespace mc = mresim::mess_config;
 using mresim::config::ConfigError;
-using mresim::config::TableReader;
+using mresim::testing::edit;
+using mresim::testing::read_spec;
 using mresim::testing::read_text;
+using mresim::testing::spec_error_of;
 using mresim::testing::TempDir;
 using mresim::testing::write_text;
 
@@ -53,26 +57,6 @@ const std::string kAnisotropyWarning =
     "lattice spacings (l_e = 1e-06 m, 10 x 10 x 37 nodes) changes the box volume by a factor "
     "1.03132";
 
-// Replaces the first occurrence of `from` in `text`.
-std::string edit(std::string text, const std::string& from, const std::string& to) {
-  const auto at = text.find(from);
-  if (at == std::string::npos) throw std::logic_error("no " + from);
-  return text.replace(at, from.size(), to);
-}
-
-mc::MessSpec spec_of(const std::string& text) {
-  return mc::read_mess_run_file(TableReader::parse_string(text, "run.toml"));
-}
-
-std::string error_of(const std::string& text) {
-  try {
-    (void)spec_of(text);
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
-
 struct Cli {
   int status = -1;
   std::string err;
@@ -92,7 +76,7 @@ Cli run_cli(const TempDir& dir, const std::string& args, const std::string& env 
 // ------------------------------------------------------------------- A. actual volume fraction
 
 TEST(MessInputWarnings, AnisotropyFactorsWhoseProductIsNotOneAreReported) {
-  const mc::MessSpec spec = spec_of(kAnisotropic);
+  const mc::MessSpec spec = read_spec(kAnisotropic);
   EXPECT_NEAR(spec.geometry.volume_fraction, 0.00969627, 1e-8);
   ASSERT_EQ(spec.warnings.size(), 1U);
   EXPECT_EQ(spec.warnings[0], kAnisotropyWarning);
@@ -103,11 +87,11 @@ TEST(MessInputWarnings, NoWarningWithinOnePercentOrWithoutAVolumeFraction) {
   const std::string single =
       edit(edit(kAnisotropic, "anisotropy_factor = [1, 1, 2]", "anisotropy_factor = 2.0"),
            "volume_fraction = 0.02", "volume_fraction = 0.05");
-  const mc::MessSpec five = spec_of(edit(single, "discretization_order = 1", ""));
+  const mc::MessSpec five = read_spec(edit(single, "discretization_order = 1", ""));
   EXPECT_LT(std::abs(five.geometry.volume_fraction / 0.05 - 1.0), mc::kVolumeFractionTolerance);
   EXPECT_TRUE(five.warnings.empty()) << five.warnings.front();
   // Rounding alone beyond 1 % (Phi = 0.05 at n_d = 1 is 0.0443867) is reported as rounding.
-  const mc::MessSpec one = spec_of(edit(
+  const mc::MessSpec one = read_spec(edit(
       edit(edit(kAnisotropic, "placement = \"regular_anisotropic\"", "placement = \"regular\""),
            "anisotropy_factor = [1, 1, 2]\n", ""),
       "volume_fraction = 0.02", "volume_fraction = 0.05"));
@@ -159,13 +143,15 @@ const std::string kRadiusRule =
 
 TEST(MessInputMessages, RadiusOutOfRangeNamesTheRadius) {
   const std::string regular = edit(kAnisotropic, "placement", "radius = 5e-324\nplacement");
-  EXPECT_EQ(error_of(regular), "particles.radius = 5e-324" + kRadiusRule);
-  EXPECT_EQ(error_of(edit(regular, "5e-324", "1e-300")), "particles.radius = 1e-300" + kRadiusRule);
-  EXPECT_EQ(error_of(edit(regular, "5e-324", "1e31")), "particles.radius = 1e+31" + kRadiusRule);
+  EXPECT_EQ(spec_error_of(regular), "particles.radius = 5e-324" + kRadiusRule);
+  EXPECT_EQ(spec_error_of(edit(regular, "5e-324", "1e-300")),
+            "particles.radius = 1e-300" + kRadiusRule);
+  EXPECT_EQ(spec_error_of(edit(regular, "5e-324", "1e31")),
+            "particles.radius = 1e+31" + kRadiusRule);
   // A box placement used to blame box.size.
   const std::string chain = edit(mresim::mess_protocol::testing::small_hysteresis(0.05, 1),
                                  "placement", "radius = 5e-324\nplacement");
-  EXPECT_EQ(error_of(chain), "particles.radius = 5e-324" + kRadiusRule);
+  EXPECT_EQ(spec_error_of(chain), "particles.radius = 5e-324" + kRadiusRule);
 }
 
 TEST(MessInputMessages, FieldsThatWouldOverflowAreRefusedOnTheirKey) {
@@ -173,16 +159,16 @@ TEST(MessInputMessages, FieldsThatWouldOverflowAreRefusedOnTheirKey) {
       "the largest field must be <= 2.87e+10 T (mu0 H): beyond it chi0 H/Ms exceeds 1e+12, "
       "where 1 - |M|/Ms in the self energy's log(1 - |M|/Ms) (eq. 4.76) is below what doubles "
       "resolve (lab fields are below 100 T)";
-  EXPECT_EQ(error_of(edit(kAnisotropic, "max = 0.05", "max = 1e308")),
+  EXPECT_EQ(spec_error_of(edit(kAnisotropic, "max = 0.05", "max = 1e308")),
             "field.max = 1e+308: " + why);
-  EXPECT_EQ(error_of(edit(kAnisotropic, "max = 0.05\nsteps = 1", "magnitudes = [0.0, 1e11]")),
+  EXPECT_EQ(spec_error_of(edit(kAnisotropic, "max = 0.05\nsteps = 1", "magnitudes = [0.0, 1e11]")),
             "field.magnitudes = [0.0, 100000000000.0]: " + why);
-  EXPECT_EQ(error_of(edit(kAnisotropic, "max = 0.05\nsteps = 1", "values = [[0, 0, 1e308]]")),
+  EXPECT_EQ(spec_error_of(edit(kAnisotropic, "max = 0.05\nsteps = 1", "values = [[0, 0, 1e308]]")),
             "field.values = [[0, 0, 1e+308]]: " + why);
   // Just below the limit is accepted (and runs: 2.8e10 T gives finite results).
-  EXPECT_EQ(error_of(edit(kAnisotropic, "max = 0.05", "max = 2.8e10")), "(no error)");
+  EXPECT_EQ(spec_error_of(edit(kAnisotropic, "max = 0.05", "max = 2.8e10")), "(no error)");
   // A lab field with an absurd chi0 blames chi0.
-  EXPECT_EQ(error_of(edit(kAnisotropic, "placement", "susceptibility = 1e200\nplacement")),
+  EXPECT_EQ(spec_error_of(edit(kAnisotropic, "placement", "susceptibility = 1e200\nplacement")),
             "particles.susceptibility = 1e+200: with the largest field 0.05 T, chi0 H/Ms reaches "
             "2.49e+198, above 1e+12, where 1 - |M|/Ms in the self energy's log(1 - |M|/Ms) (eq. "
             "4.76) is below what doubles resolve; chi0 must be <= 4.02e+13 here (iron's is of "
@@ -192,27 +178,28 @@ TEST(MessInputMessages, FieldsThatWouldOverflowAreRefusedOnTheirKey) {
 TEST(MessInputMessages, StressesBeyondTheLatticeAreRefusedOnTheirKey) {
   const std::string stress = edit(edit(kAnisotropic, "mess_hysteresis", "mess_stress"), "[output]",
                                   "[stress]\nkind = \"tension\"\nmax = 1e308\nsteps = 2\n[output]");
-  EXPECT_EQ(error_of(stress).rfind("stress.max = 1e+308: the largest stress must be <= 9e+04 Pa: "
-                                   "beyond it the traction force on a face node",
-                                   0),
-            0U)
-      << error_of(stress);
-  EXPECT_EQ(error_of(edit(stress, "1e308", "1e150")),
+  EXPECT_EQ(
+      spec_error_of(stress).rfind("stress.max = 1e+308: the largest stress must be <= 9e+04 Pa: "
+                                  "beyond it the traction force on a face node",
+                                  0),
+      0U)
+      << spec_error_of(stress);
+  EXPECT_EQ(spec_error_of(edit(stress, "1e308", "1e150")),
             "stress.max = 1e+150: the largest stress must be <= 10 x model.youngs_modulus = "
             "90000 Pa: beyond it the engineering strain (~ stress/E) exceeds 10, far outside the "
             "lattice's small-strain springs, and the relaxation does not converge");
-  EXPECT_EQ(error_of(edit(stress, "1e308", "100.0")), "(no error)");
+  EXPECT_EQ(spec_error_of(edit(stress, "1e308", "100.0")), "(no error)");
 }
 
 TEST(MessInputMessages, MisspeltRequiredKeysAreNamed) {
-  EXPECT_EQ(error_of(edit(kAnisotropic, "steps = 1", "stpes = 1")),
+  EXPECT_EQ(spec_error_of(edit(kAnisotropic, "steps = 1", "stpes = 1")),
             "field.steps = (missing): field.max needs field.steps, the number of increments from "
             "0 to max (integer >= 1); the file has 'field.stpes' - a misspelling?");
-  EXPECT_EQ(error_of(edit(kAnisotropic, "count_per_axis", "count_per_axes")),
+  EXPECT_EQ(spec_error_of(edit(kAnisotropic, "count_per_axis", "count_per_axes")),
             "missing key 'particles.count_per_axis' ([nx, ny, nz], particles along x, y and z); "
             "the file has 'particles.count_per_axes' - a misspelling?");
   // Without a look-alike key the message is as before.
-  EXPECT_EQ(error_of(edit(kAnisotropic, "steps = 1", "")),
+  EXPECT_EQ(spec_error_of(edit(kAnisotropic, "steps = 1", "")),
             "field.steps = (missing): field.max needs field.steps, the number of increments from "
             "0 to max (integer >= 1)");
 }
@@ -220,7 +207,7 @@ TEST(MessInputMessages, MisspeltRequiredKeysAreNamed) {
 // ----------------------------------------------------------------------------- B. memory
 
 TEST(MessMemory, EstimateIsFixedPlusPerNodePlusDenseMagnetization) {
-  const mc::MessSpec spec = spec_of(kAnisotropic);  // 3,700 nodes, 2 particles
+  const mc::MessSpec spec = read_spec(kAnisotropic);  // 3,700 nodes, 2 particles
   EXPECT_EQ(spec.geometry.node_count(), 3700);
   EXPECT_EQ(mc::estimated_memory_bytes(spec), mc::kFixedBytes + 3700 * mc::kBytesPerNode + 32 * 36);
   EXPECT_NO_THROW(mc::check_memory(spec, {mc::estimated_memory_bytes(spec), "test"}));
@@ -246,7 +233,7 @@ TEST(MessMemory, EstimateIsFixedPlusPerNodePlusDenseMagnetization) {
            "[field]\nmax = 0.05\nsteps = 1\n",
            "[field]\nmagnitudes = [0.0, 0.01, 0.02]\n[strain]\nkind = \"shear\"\nnormal = "
            "\"z\"\ndirection = \"x\"\nmax = 0.02\nsteps = 2\n");
-  const mc::MessSpec sheared = spec_of(strain);
+  const mc::MessSpec sheared = read_spec(strain);
   ASSERT_EQ(sheared.load_step_count(), 3U);
   EXPECT_EQ(mc::estimated_memory_bytes(sheared),
             mc::kFixedBytes + 3700 * mc::kBytesPerNode + 32 * 36);

@@ -6,18 +6,15 @@
 #include <string>
 #include <variant>
 
+#include "../support/mess_run_file.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
 
 namespace {
 
-using mresim::config::TableReader;
+using mresim::testing::read_spec;
 using namespace mresim::mess_config;
 namespace lattice = mresim::lattice;
 namespace magnetism = mresim::magnetism;
-
-MessSpec read(const std::string& text) {
-  return read_mess_run_file(TableReader::parse_string(text, "run.toml"));
-}
 
 std::string chain(const std::string& model, const std::string& particles, const std::string& box) {
   return "[run]\ntype = \"mess_hysteresis\"\n[model]\n" + model +
@@ -26,18 +23,18 @@ std::string chain(const std::string& model, const std::string& particles, const 
 }
 
 TEST(MessConfigNamedValues, BoxSizeAndRoundingWithProfileDefaults) {
-  const MessSpec physical = read(chain("", "", ""));
+  const MessSpec physical = read_spec(chain("", "", ""));
   ASSERT_TRUE(physical.box.has_value());
   EXPECT_EQ(physical.box->lengths, Eigen::Vector3d(12e-6, 12e-6, 20e-6));
   EXPECT_EQ(physical.box->rounding, physical.profile->default_box_rounding);
-  const MessSpec seed = read(chain("profile = \"seed\"", "", ""));
+  const MessSpec seed = read_spec(chain("profile = \"seed\"", "", ""));
   EXPECT_EQ(seed.box->rounding, seed.profile->default_box_rounding);
   // Each name gives its value whatever the profile's default.
   for (const char* profile : {"\"seed\"", "\"physical\""}) {
     const std::string model = std::string("profile = ") + profile;
-    EXPECT_EQ(read(chain(model, "", "rounding = \"nearest\"")).box->rounding,
+    EXPECT_EQ(read_spec(chain(model, "", "rounding = \"nearest\"")).box->rounding,
               lattice::BoxRounding::nearest);
-    EXPECT_EQ(read(chain(model, "", "rounding = \"seed_floor_divide\"")).box->rounding,
+    EXPECT_EQ(read_spec(chain(model, "", "rounding = \"seed_floor_divide\"")).box->rounding,
               lattice::BoxRounding::seed_floor_divide);
   }
 }
@@ -46,12 +43,12 @@ TEST(MessConfigNamedValues, ChainAxisAndCentre) {
   const auto placement = [](const MessSpec& s) {
     return std::get<lattice::ChainPlacement>(s.lattice.placement);
   };
-  EXPECT_EQ(placement(read(chain("", "", ""))).axis, 2);
-  EXPECT_FALSE(placement(read(chain("", "", ""))).centre.has_value());
-  EXPECT_EQ(placement(read(chain("", "axis = \"x\"", ""))).axis, 0);
-  EXPECT_EQ(placement(read(chain("", "axis = \"y\"", ""))).axis, 1);
-  EXPECT_EQ(placement(read(chain("", "axis = \"z\"", ""))).axis, 2);
-  const auto centred = placement(read(chain("", "centre = [6e-6, 6e-6, 9e-6]", "")));
+  EXPECT_EQ(placement(read_spec(chain("", "", ""))).axis, 2);
+  EXPECT_FALSE(placement(read_spec(chain("", "", ""))).centre.has_value());
+  EXPECT_EQ(placement(read_spec(chain("", "axis = \"x\"", ""))).axis, 0);
+  EXPECT_EQ(placement(read_spec(chain("", "axis = \"y\"", ""))).axis, 1);
+  EXPECT_EQ(placement(read_spec(chain("", "axis = \"z\"", ""))).axis, 2);
+  const auto centred = placement(read_spec(chain("", "centre = [6e-6, 6e-6, 9e-6]", "")));
   ASSERT_TRUE(centred.centre.has_value());
   EXPECT_EQ(*centred.centre, Eigen::Vector3d(6e-6, 6e-6, 9e-6));
 }
@@ -69,7 +66,7 @@ size = [12e-6, 12e-6, 16e-6]
 [field]
 values = [[0, 0, 0], [0.01, 0, -0.02]]
 )";
-  const MessSpec s = read(text);
+  const MessSpec s = read_spec(text);
   const auto& positions = std::get<lattice::ByHandPlacement>(s.lattice.placement).positions;
   ASSERT_EQ(positions.size(), 2U);
   EXPECT_EQ(positions[0], Eigen::Vector3d(6e-6, 6e-6, 5e-6));
@@ -79,22 +76,23 @@ values = [[0, 0, 0], [0.01, 0, -0.02]]
   ASSERT_EQ(s.field.values.size(), 2U);
   EXPECT_EQ(s.field.values[1], Eigen::Vector3d(0.01, 0.0, -0.02));
   EXPECT_DOUBLE_EQ(s.field.max, Eigen::Vector3d(0.01, 0.0, -0.02).norm());
-  EXPECT_EQ(read(chain("", "", "")).self_energy, magnetism::SelfEnergyForm::consistent);
-  EXPECT_EQ(read(chain("", "self_energy = \"consistent\"", "")).self_energy,
+  EXPECT_EQ(read_spec(chain("", "", "")).self_energy, magnetism::SelfEnergyForm::consistent);
+  EXPECT_EQ(read_spec(chain("", "self_energy = \"consistent\"", "")).self_energy,
             magnetism::SelfEnergyForm::consistent);
 }
 
 TEST(MessConfigNamedValues, FieldSequenceNamedOrDefaultOfTheRunType) {
   const std::string hysteresis = chain("", "", "");
-  EXPECT_EQ(read(hysteresis).field.sequence, FieldSequence::loop);
-  EXPECT_EQ(read(hysteresis).field.values.size(), 11U);  // 0 -> max -> -max -> max, 2 steps
+  EXPECT_EQ(read_spec(hysteresis).field.sequence, FieldSequence::loop);
+  EXPECT_EQ(read_spec(hysteresis).field.values.size(), 11U);  // 0 -> max -> -max -> max, 2 steps
   const std::string up = hysteresis + "sequence = \"up\"\n";
-  EXPECT_EQ(read(up).field.sequence, FieldSequence::up);
-  EXPECT_EQ(read(up).field.values.size(), 3U);
+  EXPECT_EQ(read_spec(up).field.sequence, FieldSequence::up);
+  EXPECT_EQ(read_spec(up).field.values.size(), 3U);
   std::string magnetostriction = hysteresis;
   magnetostriction.replace(magnetostriction.find("mess_hysteresis"), 15, "mess_magnetostriction");
-  EXPECT_EQ(read(magnetostriction).field.sequence, FieldSequence::up);
-  EXPECT_EQ(read(magnetostriction + "sequence = \"loop\"\n").field.sequence, FieldSequence::loop);
+  EXPECT_EQ(read_spec(magnetostriction).field.sequence, FieldSequence::up);
+  EXPECT_EQ(read_spec(magnetostriction + "sequence = \"loop\"\n").field.sequence,
+            FieldSequence::loop);
 }
 
 }  // namespace

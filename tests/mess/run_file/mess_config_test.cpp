@@ -7,6 +7,8 @@
 #include <numbers>
 #include <string>
 
+#include "../../support/dissertation_values.hpp"
+#include "../support/mess_run_file.hpp"
 #include "mresim/mess/protocols/protocol.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
 
@@ -14,12 +16,10 @@ namespace {
 
 using mresim::app::InfoReport;
 using mresim::config::TableReader;
+using mresim::testing::kR;
+using mresim::testing::read_spec;
 using namespace mresim::mess_config;
 namespace lattice = mresim::lattice;
-
-MessSpec read(const std::string& text) {
-  return read_mess_run_file(TableReader::parse_string(text, "run.toml"));
-}
 
 // The protocol's settings (mresim::mess_protocol::settings_of): nullptr for another protocol.
 const StrainSpec* strain_of(const MessSpec& s) {
@@ -59,14 +59,13 @@ std::string regular_two(double phi, const std::string& extra_model = "") {
          "\ncount_per_axis = [1, 1, 2]\n[field]\nmax = 0.06\nsteps = 12\n";
 }
 
-constexpr double kR = 1.5e-6;
 constexpr double kLe = kR / 5.5;
 
 // Phi = 1 %, two particles along z: docs/original-code.md#springs lists every spring category.
 TEST(MessConfigSystems, OnePercentTwoParticles) {
   for (const std::string profile : {"physical", "seed"}) {
     SCOPED_TRACE(profile);
-    const MessSpec spec = read(regular_two(0.01, "profile = \"" + profile + "\""));
+    const MessSpec spec = read_spec(regular_two(0.01, "profile = \"" + profile + "\""));
     const InfoReport r = info(spec);
     EXPECT_EQ(text(r, "lattice", "grid"), "42 x 42 x 83");
     EXPECT_EQ(integer(r, "lattice", "nodes"), 146412);
@@ -107,7 +106,7 @@ struct D1 {
 class MessConfigVolumeFraction : public ::testing::TestWithParam<D1> {};
 
 TEST_P(MessConfigVolumeFraction, NodeAndCellCountsOfTheDissertation) {
-  const InfoReport r = info(read(regular_two(GetParam().phi)));
+  const InfoReport r = info(read_spec(regular_two(GetParam().phi)));
   EXPECT_EQ(text(r, "lattice", "grid"), GetParam().grid);
   EXPECT_EQ(integer(r, "lattice", "nodes"), GetParam().nodes);
   EXPECT_EQ(integer(r, "lattice", "cells"), GetParam().cells);
@@ -149,7 +148,7 @@ steps = 10
 // sizes by-hand boxes as the original did (44 x 44 x 147, Phi 0.516 %). The strain protocol
 // of Listing A.2: 12 fields x 11 strains.
 TEST(MessConfigSystems, TwoParticlesInTheLargeBox) {
-  const MessSpec spec = read(kLargeBoxChain);
+  const MessSpec spec = read_spec(kLargeBoxChain);
   const InfoReport r = info(spec);
   EXPECT_EQ(text(r, "lattice", "grid"), "44 x 44 x 147");
   EXPECT_EQ(integer(r, "lattice", "nodes"), 284592);
@@ -171,10 +170,10 @@ TEST(MessConfigSystems, TwoParticlesInTheLargeBox) {
   // The physical profile rounds to the nearest node count (12 um = 44 l_e exactly).
   std::string physical = kLargeBoxChain;
   physical.replace(physical.find("profile = \"seed\""), 16, "profile = \"physical\"");
-  EXPECT_EQ(text(info(read(physical)), "lattice", "grid"), "45 x 45 x 148");
+  EXPECT_EQ(text(info(read_spec(physical)), "lattice", "grid"), "45 x 45 x 148");
   // ... unless told otherwise.
   physical.replace(physical.find("[box]"), 5, "[box]\nrounding = \"seed_floor_divide\"");
-  EXPECT_EQ(text(info(read(physical)), "lattice", "grid"), "44 x 44 x 147");
+  EXPECT_EQ(text(info(read_spec(physical)), "lattice", "grid"), "44 x 44 x 147");
 }
 
 // Fig. 4.20: four particles 6 um apart in the same box, Phi ~ 1 %.
@@ -182,7 +181,7 @@ TEST(MessConfigSystems, FourParticleChain) {
   std::string text_ = kLargeBoxChain;
   text_.replace(text_.find("count = 2\nseparation = 6.5454e-6"), 32,
                 "count = 4\nseparation = 6e-6");
-  const MessSpec spec = read(text_);
+  const MessSpec spec = read_spec(text_);
   const InfoReport r = info(spec);
   EXPECT_EQ(integer(r, "lattice", "nodes"), 284592);
   EXPECT_EQ(integer(r, "particles", "count"), 4);
@@ -193,7 +192,7 @@ TEST(MessConfigSystems, FourParticleChain) {
 // Section 4.3.3 / Listing A.2: the 8-particle helix, R_helix = 3.5 um, in 18 x 18 x 62 um
 // (66 x 66 x 228 nodes). `info` must stay fast: no lattice is built.
 TEST(MessConfigSystems, Helix) {
-  const MessSpec spec = read(R"(
+  const MessSpec spec = read_spec(R"(
 [run]
 type = "mess_strain"
 [model]
@@ -237,7 +236,7 @@ dt = 4e-3
 // docs/original-code.md#lengths-spring-constants-and-scaling (k_eff, t_c) from the seed's closed
 // forms.
 TEST(MessConfigSystems, StiffnessAndScalesOfBothProfiles) {
-  const InfoReport physical = info(read(regular_two(0.05)));
+  const InfoReport physical = info(read_spec(regular_two(0.05)));
   EXPECT_NEAR(number(physical, "stiffness", "k_e"), 1.3120e-3, 1e-7);
   EXPECT_NEAR(number(physical, "stiffness", "k_f"), 3.5781e-4, 1e-8);
   EXPECT_NEAR(number(physical, "stiffness", "k_c"), 3.5781e-4, 1e-8);
@@ -246,7 +245,7 @@ TEST(MessConfigSystems, StiffnessAndScalesOfBothProfiles) {
   EXPECT_NEAR(number(physical, "stiffness", "lattice_youngs_modulus"), 9e3, 1e-6);
   EXPECT_NEAR(number(physical, "stiffness", "lattice_poisson_ratio"), 0.47, 1e-12);
 
-  const InfoReport seed = info(read(regular_two(0.05, "profile = \"seed\"")));
+  const InfoReport seed = info(read_spec(regular_two(0.05, "profile = \"seed\"")));
   const double E = 9e3;
   const double k_e = 22.0 / 35.0 * E * kLe;
   const double k_c = 6.0 / 35.0 * E * kLe;
@@ -269,7 +268,7 @@ TEST(MessConfigSystems, StiffnessAndScalesOfBothProfiles) {
 
 // A minimal file: every default of docs/run-files-3d.md.
 TEST(MessConfigSystems, Defaults) {
-  const MessSpec s = read(regular_two(0.05));
+  const MessSpec s = read_spec(regular_two(0.05));
   EXPECT_EQ(s.run_type, "mess_hysteresis");
   EXPECT_EQ(s.profile->name, "physical");
   EXPECT_EQ(s.lattice.youngs_modulus, 9e3);
@@ -319,25 +318,25 @@ TEST(MessConfigSystems, Defaults) {
 // original code's loose band; explicit atol and rtol override the named tolerance.
 TEST(MessConfigSystems, MagnetizationTolerance) {
   const std::string seed = regular_two(0.05, "profile = \"seed\"");
-  const MessSpec tight = read(seed);
+  const MessSpec tight = read_spec(seed);
   EXPECT_EQ(tight.solver.magnetization.atol, 1e-12);
   EXPECT_EQ(tight.solver.magnetization.rtol, 1e-12);
   EXPECT_EQ(text(info(tight), "solver", "magnetization_tolerance"), "tight");
 
-  const MessSpec original = read(seed + "[solver.magnetization]\ntolerance = \"original\"\n");
+  const MessSpec original = read_spec(seed + "[solver.magnetization]\ntolerance = \"original\"\n");
   EXPECT_EQ(original.solver.magnetization.atol, 1e-3);
   EXPECT_EQ(original.solver.magnetization.rtol, 5e-3);
   EXPECT_EQ(number(info(original), "solver", "magnetization_atol"), 1e-3);
   EXPECT_EQ(text(info(original), "solver", "magnetization_tolerance"), "original");
 
-  const MessSpec mixed =
-      read(regular_two(0.05) + "[solver.magnetization]\ntolerance = \"original\"\natol = 1e-6\n");
+  const MessSpec mixed = read_spec(
+      regular_two(0.05) + "[solver.magnetization]\ntolerance = \"original\"\natol = 1e-6\n");
   EXPECT_EQ(mixed.solver.magnetization.atol, 1e-6);
   EXPECT_EQ(mixed.solver.magnetization.rtol, 5e-3);
   EXPECT_EQ(text(info(mixed), "solver", "magnetization_tolerance"), "custom");
 
   const MessSpec named_tight =
-      read(regular_two(0.05) + "[solver.magnetization]\ntolerance = \"tight\"\nrtol = 0\n");
+      read_spec(regular_two(0.05) + "[solver.magnetization]\ntolerance = \"tight\"\nrtol = 0\n");
   EXPECT_EQ(named_tight.solver.magnetization.atol, 1e-12);
   EXPECT_EQ(named_tight.solver.magnetization.rtol, 0.0);
 }
@@ -346,7 +345,7 @@ TEST(MessConfigSystems, MagnetizationTolerance) {
 TEST(MessConfigField, HysteresisLoopAndDirections) {
   const std::vector<double> loop = hysteresis_loop({0.0, 1.0, 2.0});
   EXPECT_EQ(loop, (std::vector<double>{0, 1, 2, 1, 0, -1, -2, -1, 0, 1, 2}));
-  const MessSpec s = read(regular_two(0.05));
+  const MessSpec s = read_spec(regular_two(0.05));
   ASSERT_EQ(s.field.values.size(), 61u);
   EXPECT_NEAR(s.field.values[12][2], 0.06, 1e-15);
   EXPECT_NEAR(s.field.values[36][2], -0.06, 1e-15);
@@ -366,14 +365,14 @@ TEST(MessConfigField, HysteresisLoopAndDirections) {
   std::string vectors = regular_two(0.05);
   vectors.replace(vectors.find("max = 0.06\nsteps = 12"), 21,
                   "values = [[0, 0, 0], [0.01, 0, 0.02], [0, -0.03, 0]]");
-  const MessSpec v = read(vectors);
+  const MessSpec v = read_spec(vectors);
   ASSERT_EQ(v.field.values.size(), 3u);
   EXPECT_EQ(v.field.values[1], Eigen::Vector3d(0.01, 0, 0.02));
   EXPECT_NEAR(v.field.max, 0.03, 1e-15);
 
   std::string up = regular_two(0.05);
   up.replace(up.find("steps = 12"), 10, "steps = 12\nsequence = \"up\"");
-  EXPECT_EQ(read(up).field.values.size(), 13u);
+  EXPECT_EQ(read_spec(up).field.values.size(), 13u);
 }
 
 TEST(MessConfigPlacement, AnisotropicAliasNoiseAndByHand) {
@@ -390,7 +389,7 @@ noise_seed = 7
 max = 0.1
 steps = 2
 )";
-  const MessSpec a = read(aniso);
+  const MessSpec a = read_spec(aniso);
   EXPECT_EQ(a.placement_kind, lattice::PlacementKind::regular_anisotropic_noisy);
   const auto& r = std::get<lattice::RegularPlacement>(a.lattice.placement);
   EXPECT_TRUE(r.anisotropic);
@@ -402,13 +401,13 @@ steps = 2
   EXPECT_EQ(a.field.sequence, FieldSequence::up);
   EXPECT_EQ(a.field.values.size(), 3u);
   // The same seed gives the same centres; the explicit factors give the same box.
-  EXPECT_EQ(read(aniso).geometry.centre_cells, a.geometry.centre_cells);
+  EXPECT_EQ(read_spec(aniso).geometry.centre_cells, a.geometry.centre_cells);
   std::string explicit_factors = aniso;
   explicit_factors.replace(explicit_factors.find("anisotropy_factor = 1.5"), 23,
                            "anisotropy_factor = [0.8164965809277261, 0.8164965809277261, 1.5]");
-  EXPECT_EQ(read(explicit_factors).geometry.shape.nodes, a.geometry.shape.nodes);
+  EXPECT_EQ(read_spec(explicit_factors).geometry.shape.nodes, a.geometry.shape.nodes);
 
-  const MessSpec h = read(R"(
+  const MessSpec h = read_spec(R"(
 [run]
 type = "mess_hysteresis"
 [particles]
@@ -440,7 +439,7 @@ magnitudes = [0.0, 0.05]
   const auto with_type = [&](const std::string& type, const std::string& table) {
     std::string t = base;
     t.replace(t.find("TYPE"), 4, type);
-    return read(t + table);
+    return read_spec(t + table);
   };
   const MessSpec c = with_type("mess_strain",
                                "[strain]\nkind = \"compression\"\nnormal = \"x\"\nmax = 0.1\n"
@@ -473,7 +472,7 @@ magnitudes = [0.0, 0.05]
 }
 
 TEST(MessConfigReport, TextOfTheReportNamesTheCounts) {
-  const std::string out = info(read(regular_two(0.01))).to_text();
+  const std::string out = info(read_spec(regular_two(0.01))).to_text();
   EXPECT_NE(out.find("nodes"), std::string::npos);
   EXPECT_NE(out.find("146412"), std::string::npos);
   EXPECT_NE(out.find("centre_1"), std::string::npos);

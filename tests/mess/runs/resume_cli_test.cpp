@@ -19,21 +19,16 @@
 #include "../../support/child_process.hpp"
 #include "../../support/hdf5_read.hpp"
 #include "../../support/temp_dir.hpp"
+#include "../restart/restart_cli_support.hpp"
 #include "../support/small_runs.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
+using mresim::mess_protocol::testing::mresim_in;
+using mresim::mess_protocol::testing::staged_checkpoint;
 using mresim::testing::Hdf5Reader;
 using mresim::testing::TempDir;
-
-// Runs `mresim args` in `dir`, quietly; returns the exit status.
-int mresim_status(const fs::path& dir, const std::string& args) {
-  const std::string command = "cd '" + dir.string() + "' && '" + MRESIM_CLI_PATH + "' " + args +
-                              " >/dev/null 2>'" + (dir / ".stderr").string() + "' </dev/null";
-  const int raw = std::system(command.c_str());
-  return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-}
 
 // Starts `mresim ARGS...` in `dir` without waiting for it (stdout to /dev/null, stderr to
 // `dir`/.stderr-<tag>).
@@ -53,7 +48,7 @@ pid_t start_run(const fs::path& dir, const std::string& file, const std::string&
 }
 
 // The step datasets two runs of the same file must agree on bit for bit.
-void expect_identical_steps(const fs::path& a_dir, const fs::path& b_dir) {
+void expect_identical_resumed_steps(const fs::path& a_dir, const fs::path& b_dir) {
   const Hdf5Reader a(a_dir / "results.h5");
   const Hdf5Reader b(b_dir / "results.h5");
   for (const char* path :
@@ -70,23 +65,12 @@ void expect_identical_steps(const fs::path& a_dir, const fs::path& b_dir) {
 
 int exit_status_of(pid_t pid) { return mresim::testing::wait_child(pid); }
 
-// The checkpoint of the running process's staging directory, once it exists.
-fs::path staged_checkpoint(const fs::path& dir, const std::string& out) {
-  for (const auto& e : fs::directory_iterator(dir)) {
-    const std::string name = e.path().filename().string();
-    if (name.rfind(out + ".partial-", 0) == 0 && fs::exists(e.path() / "checkpoint.h5")) {
-      return e.path() / "checkpoint.h5";
-    }
-  }
-  return {};
-}
-
 TEST(MessResumeCli, KilledRunResumedGivesTheSameResults) {
   const TempDir dir;
   // 51 steps of a few tens of milliseconds each: killed a few steps after its first checkpoint.
   const std::string toml = mresim::mess_protocol::testing::small_hysteresis(0.2, 10);
   { std::ofstream(dir / "run.toml") << toml; }
-  ASSERT_EQ(mresim_status(dir.path(), "run run.toml --out full --no-plot -j 1"), 0);
+  ASSERT_EQ(mresim_in(dir.path(), "run run.toml --out full --no-plot -j 1"), 0);
 
   const pid_t pid = start_run(dir.path(), "run.toml", "killed");
   ASSERT_GT(pid, 0);
@@ -109,7 +93,7 @@ TEST(MessResumeCli, KilledRunResumedGivesTheSameResults) {
   ASSERT_TRUE(killed) << "the run finished or never checkpointed before it could be killed";
   ASSERT_FALSE(fs::exists(dir / "killed"));  // nothing published by the killed run
 
-  ASSERT_EQ(mresim_status(dir.path(), "resume killed --no-plot -j 1"), 0)
+  ASSERT_EQ(mresim_in(dir.path(), "resume killed --no-plot -j 1"), 0)
       << mresim::testing::read_text(dir / ".stderr");
   // It continued from the checkpoint rather than starting over.
   EXPECT_NE(mresim::testing::read_text(dir / ".stderr").find("resuming at step"),
@@ -117,7 +101,7 @@ TEST(MessResumeCli, KilledRunResumedGivesTheSameResults) {
   ASSERT_TRUE(fs::exists(dir / "killed" / "results.h5"));
   EXPECT_FALSE(fs::exists(dir / "killed" / "checkpoint.h5"));
 
-  expect_identical_steps(dir / "full", dir / "killed");
+  expect_identical_resumed_steps(dir / "full", dir / "killed");
   EXPECT_EQ(Hdf5Reader(dir / "full" / "results.h5").doubles("/steps/field").size(), 51U * 3U);
 }
 
@@ -129,7 +113,7 @@ TEST(MessResumeCli, SigtermWritesACheckpointAndTheResumedRunIsIdentical) {
   {
     std::ofstream(dir / "run.toml") << mresim::mess_protocol::testing::small_hysteresis(0.2, 4, 0);
   }
-  ASSERT_EQ(mresim_status(dir.path(), "run run.toml --out full --no-plot -j 1"), 0);
+  ASSERT_EQ(mresim_in(dir.path(), "run run.toml --out full --no-plot -j 1"), 0);
 
   const pid_t pid = start_mresim(dir.path(), {"run", "run.toml", "--out", "stopped", "--no-plot"});
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
@@ -146,11 +130,11 @@ TEST(MessResumeCli, SigtermWritesACheckpointAndTheResumedRunIsIdentical) {
   EXPECT_FALSE(fs::exists(dir / "stopped"));
   EXPECT_FALSE(fs::exists(dir / "stopped.mresim-lock"));
 
-  ASSERT_EQ(mresim_status(dir.path(), "resume stopped --no-plot -j 1"), 0)
+  ASSERT_EQ(mresim_in(dir.path(), "resume stopped --no-plot -j 1"), 0)
       << mresim::testing::read_text(dir / ".stderr");
   EXPECT_NE(mresim::testing::read_text(dir / ".stderr").find("resuming at step"),
             std::string::npos);
-  expect_identical_steps(dir / "full", dir / "stopped");
+  expect_identical_resumed_steps(dir / "full", dir / "stopped");
 }
 
 // While a run is going on, `resume` of its directory is refused without advising a new run
@@ -163,7 +147,7 @@ TEST(MessResumeCli, ResumeWhileTheRunIsGoingOnIsRefused) {
   while (!fs::exists(dir / "busy.mresim-lock") && std::chrono::steady_clock::now() < deadline) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  EXPECT_EQ(mresim_status(dir.path(), "resume busy --no-plot"), 2);
+  EXPECT_EQ(mresim_in(dir.path(), "resume busy --no-plot"), 2);
   const std::string err = mresim::testing::read_text(dir / ".stderr");
   EXPECT_NE(err.find("is in use by mresim run, pid " + std::to_string(pid)), std::string::npos)
       << err;
@@ -179,12 +163,12 @@ TEST(MessResumeCli, TenRandomKillsAndResumesGiveTheSameResults) {
   const TempDir dir;
   { std::ofstream(dir / "run.toml") << mresim::mess_protocol::testing::small_hysteresis(0.2, 4); }
   const auto t0 = std::chrono::steady_clock::now();
-  ASSERT_EQ(mresim_status(dir.path(), "run run.toml --out full --no-plot -j 1"), 0);
+  ASSERT_EQ(mresim_in(dir.path(), "run run.toml --out full --no-plot -j 1"), 0);
   const fs::path full = dir / "full";
   // The length of one uninterrupted run, from a run of our own if the shared one was made
   // earlier.
   if (std::chrono::steady_clock::now() - t0 < std::chrono::milliseconds(100)) {
-    ASSERT_EQ(mresim_status(dir.path(), "run run.toml --out timing --no-plot -j 1"), 0);
+    ASSERT_EQ(mresim_in(dir.path(), "run run.toml --out timing --no-plot -j 1"), 0);
   }
   const double full_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -213,12 +197,12 @@ TEST(MessResumeCli, TenRandomKillsAndResumesGiveTheSameResults) {
   }
   ASSERT_TRUE(finished);
   EXPECT_EQ(kills, 10);
-  expect_identical_steps(full, dir / "chain");
+  expect_identical_resumed_steps(full, dir / "chain");
 }
 
 TEST(MessResumeCli, NothingToResumeIsAnInputError) {
   const TempDir dir;
-  EXPECT_EQ(mresim_status(dir.path(), "resume nowhere"), 2);
+  EXPECT_EQ(mresim_in(dir.path(), "resume nowhere"), 2);
   const std::string err = mresim::testing::read_text(dir / ".stderr");
   EXPECT_NE(err.find("no interrupted run with a checkpoint for 'nowhere'"), std::string::npos)
       << err;

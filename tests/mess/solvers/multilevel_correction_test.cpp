@@ -26,7 +26,7 @@ namespace {
 
 constexpr double kForceScale = 1e-9;  // N: any positive scale
 
-Eigen::VectorXd random_vector(Eigen::Index n, unsigned seed) {
+Eigen::VectorXd uniform_random_vector(Eigen::Index n, unsigned seed) {
   std::mt19937 gen(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   Eigen::VectorXd v(n);
@@ -202,7 +202,7 @@ TEST(MultilevelCorrection, IsTheGalerkinFormulaOnEveryLevel) {
     EXPECT_EQ(c.level_size(3), 3 * 8);
     const Eigen::MatrixXd expected = reference_correction(sys, map, 3);
     for (unsigned seed = 1; seed <= 3; ++seed) {
-      const Eigen::VectorXd v = random_vector(map.size(), seed);
+      const Eigen::VectorXd v = uniform_random_vector(map.size(), seed);
       const Eigen::VectorXd want = expected * v;
       EXPECT_LT((apply(c, map, v) - want).norm(), 1e-11 * want.norm()) << profile_name;
     }
@@ -238,7 +238,7 @@ TEST(MultilevelCorrection, IsTheGalerkinFormulaAtADeformedState) {
   const mess::MultilevelCorrection at_rest(l, factor, map, kForceScale);
   const mess::MultilevelCorrection at_reference(l, factor, map, kForceScale, &l.positions);
   for (unsigned seed = 1; seed <= 3; ++seed) {
-    const Eigen::VectorXd v = random_vector(map.size(), seed);
+    const Eigen::VectorXd v = uniform_random_vector(map.size(), seed);
     const Eigen::VectorXd want = expected * v;
     EXPECT_LT((apply(c, map, v) - want).norm(), 1e-11 * want.norm());
     // The deformation changes it (else the check above could not tell the states apart).
@@ -258,8 +258,8 @@ TEST(MultilevelCorrection, IsSymmetricPositiveDefinite) {
   const mess::DofMap map(sys.constraints(), l.positions, l.element_length);
   const mess::MultilevelCorrection c(l, sys.settings().elastic.volume_force_factor, map,
                                      kForceScale);
-  const Eigen::VectorXd v = random_vector(map.size(), 11);
-  const Eigen::VectorXd w = random_vector(map.size(), 12);
+  const Eigen::VectorXd v = uniform_random_vector(map.size(), 11);
+  const Eigen::VectorXd w = uniform_random_vector(map.size(), 12);
   const double vcw = v.dot(apply(c, map, w));
   EXPECT_NEAR(vcw, w.dot(apply(c, map, v)), 1e-12 * std::abs(vcw));
   EXPECT_GT(v.dot(apply(c, map, v)), 0.0);
@@ -268,7 +268,8 @@ TEST(MultilevelCorrection, IsSymmetricPositiveDefinite) {
   sys.set_constraints(faces_held(l, {lat::Face::bottom}));
   const mess::DofMap other(sys.constraints(), l.positions, l.element_length);
   Eigen::VectorXd out = Eigen::VectorXd::Zero(other.size());
-  EXPECT_THROW(c.add_to(other, random_vector(other.size(), 13), out), std::invalid_argument);
+  EXPECT_THROW(c.add_to(other, uniform_random_vector(other.size(), 13), out),
+               std::invalid_argument);
 }
 
 // The grid sweeps are split over threads by grid lines: bitwise the same result for 1, 2 and 3
@@ -287,7 +288,7 @@ TEST(MultilevelCorrection, IsBitwiseTheSameOnEveryThreadCount) {
   const mess::MultilevelCorrection c(l, sys.settings().elastic.volume_force_factor, map,
                                      kForceScale);
   EXPECT_GE(c.levels(), 2);
-  const Eigen::VectorXd v = random_vector(map.size(), 5);
+  const Eigen::VectorXd v = uniform_random_vector(map.size(), 5);
   const Eigen::VectorXd one = apply(c, map, v);
   for (const int t : {2, 3}) {
     omp_set_num_threads(t);
@@ -310,7 +311,7 @@ TEST(MultilevelCorrection, IsLeftOutWhereNothingIsHeld) {
   EXPECT_THROW(mess::MultilevelCorrection(l, 1.0, map, kForceScale), std::runtime_error);
   const mess::RigidParticlePreconditioner p(sys, map, kForceScale, true);
   EXPECT_EQ(p.multilevel(), nullptr);
-  const Eigen::VectorXd v = random_vector(map.size(), 3);
+  const Eigen::VectorXd v = uniform_random_vector(map.size(), 3);
   const mess::RigidParticlePreconditioner plain(sys, map, kForceScale, false);
   EXPECT_EQ(p.apply(map, v), plain.apply(map, v));
 }
@@ -355,7 +356,7 @@ TEST(PreconditionerCache, KeepsThePlainOneAndBuildsTheMultilevelOneAtEachState) 
   const auto deformed = cache.get(sys, other, kForceScale, true);
   EXPECT_EQ(cache.builds(), 4);
   const mess::RigidParticlePreconditioner direct(sys, other, kForceScale, true, &x);
-  const Eigen::VectorXd v = random_vector(other.size(), 4);
+  const Eigen::VectorXd v = uniform_random_vector(other.size(), 4);
   EXPECT_EQ(deformed->apply(other, v), direct.apply(other, v));
   EXPECT_NE(deformed->apply(other, v), at_rest->apply(other, v));
 }

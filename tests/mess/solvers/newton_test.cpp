@@ -32,7 +32,7 @@ using mess::testing::tesla;
 
 namespace {
 
-void tighten_magnetization(mess::MessSystem& sys) {
+void tighten_magnetization_to_1e13(mess::MessSystem& sys) {
   sys.settings().magnetization.atol = 1e-13;
   sys.settings().magnetization.rtol = 1e-13;
   sys.settings().magnetization.max_fixed_point_iterations = 5000;
@@ -44,7 +44,7 @@ mess::MessSystem pair_in_field(const char* profile = "physical") {
   mess::MessSystem sys = mess::MessSystem::make(
       small_lattice(mess::model_profile(profile), {7, 7, 13}, {{3, 3, 4}, {3, 3, 8}}),
       tesla(0.0, 0.0, 0.03), mess::model_profile(profile));
-  tighten_magnetization(sys);
+  tighten_magnetization_to_1e13(sys);
   mess::BoundaryConstraints c = mess::BoundaryConstraints::none(sys.node_count());
   c.fix_face(sys.lattice().shape, lat::Face::bottom, sys.lattice().positions);
   sys.set_constraints(c);
@@ -53,11 +53,11 @@ mess::MessSystem pair_in_field(const char* profile = "physical") {
 
 // The symmetric pair of relaxation_test.cpp: 7 x 7 x 15 cells, all faces held, particles
 // 6 l_e apart along the 0.03 T field.
-mess::MessSystem symmetric_pair() {
+mess::MessSystem physical_symmetric_pair() {
   const mess::ModelProfile& profile = mess::model_profile("physical");
   mess::MessSystem sys = mess::MessSystem::make(
       small_lattice(profile, {7, 7, 15}, {{3, 3, 4}, {3, 3, 10}}), tesla(0.0, 0.0, 0.03), profile);
-  tighten_magnetization(sys);
+  tighten_magnetization_to_1e13(sys);
   mess::BoundaryConstraints c = mess::BoundaryConstraints::none(sys.node_count());
   for (const lat::Face f : {lat::Face::left, lat::Face::right, lat::Face::front, lat::Face::back,
                             lat::Face::bottom, lat::Face::top}) {
@@ -292,7 +292,7 @@ TEST(MessNewton, MultigridPreconditionsTheElasticHessian) {
 }
 
 TEST(MessNewton, RelaxesThePairToTheStateLbfgsFinds) {
-  mess::MessSystem a = symmetric_pair();
+  mess::MessSystem a = physical_symmetric_pair();
   mess::MessSystem b = a;
   mess::MinimiserOptions opt;
   opt.force_tolerance = 1e-9;
@@ -312,7 +312,7 @@ TEST(MessNewton, RelaxesThePairToTheStateLbfgsFinds) {
 // multigrid) reaches the same state as with the default preconditioner, in fewer iterations
 // (the route measured in mess_scaling_bench).
 TEST(MessNewton, MultigridPreconditionedLbfgsReachesTheSameStateInFewerIterations) {
-  mess::MessSystem a = symmetric_pair();
+  mess::MessSystem a = physical_symmetric_pair();
   mess::MessSystem b = a;
   mess::MinimiserOptions opt;
   opt.force_tolerance = 1e-9;

@@ -12,7 +12,7 @@
 namespace mresim::mess::detail {
 namespace {
 
-Eigen::VectorXd random_vector(Eigen::Index n, unsigned seed) {
+Eigen::VectorXd normal_random_vector(Eigen::Index n, unsigned seed) {
   std::mt19937_64 random(seed);
   std::normal_distribution<double> normal;
   Eigen::VectorXd v(n);
@@ -26,9 +26,9 @@ const Eigen::Index kSizes[] = {
 
 TEST(VectorAlgebra, AgreesWithTheSerialFormulas) {
   for (const Eigen::Index n : kSizes) {
-    const Eigen::VectorXd a = random_vector(n, 1);
-    const Eigen::VectorXd b = random_vector(n, 2);
-    const Eigen::VectorXd c = random_vector(n, 3);
+    const Eigen::VectorXd a = normal_random_vector(n, 1);
+    const Eigen::VectorXd b = normal_random_vector(n, 2);
+    const Eigen::VectorXd c = normal_random_vector(n, 3);
     const double scale = a.cwiseAbs().dot(b.cwiseAbs());
     EXPECT_NEAR(parallel_dot(a, b), a.dot(b), 1e-13 * scale) << n;
     EXPECT_EQ(parallel_max_abs(a), a.cwiseAbs().maxCoeff()) << n;
@@ -51,8 +51,8 @@ TEST(VectorAlgebra, AgreesWithTheSerialFormulas) {
 
 TEST(VectorAlgebra, ResultsAreBitwiseIndependentOfTheThreadCount) {
   const Eigen::Index n = 5 * kParallelMinimum + 17;
-  const Eigen::VectorXd a = random_vector(n, 4);
-  const Eigen::VectorXd b = random_vector(n, 5);
+  const Eigen::VectorXd a = normal_random_vector(n, 4);
+  const Eigen::VectorXd b = normal_random_vector(n, 5);
   const int saved = omp_get_max_threads();
   double dots[2] = {0.0, 0.0};
   double fused[2] = {0.0, 0.0};

@@ -44,7 +44,7 @@ std::vector<Eigen::Index> sample_coordinates(const lat::Lattice& l) {
   return k;
 }
 
-Eigen::Matrix3Xd some_magnetizations(double Ms) {
+Eigen::Matrix3Xd two_particle_magnetizations(double Ms) {
   Eigen::Matrix3Xd M(3, 2);
   M.col(0) = Ms * Eigen::Vector3d(0.2, -0.1, 0.6);
   M.col(1) = Ms * Eigen::Vector3d(-0.3, 0.25, 0.5);
@@ -57,7 +57,7 @@ TEST(MessSystem, GradientMatchesFiniteDifferencesAtFixedM) {
   mess::MessSystem sys =
       two_particle_system(mess::model_profile("physical"), tesla(0.03, 0.0, 0.08));
   sys.settings().magnetization_update = mess::MagnetizationUpdate::manual;
-  sys.set_magnetizations(some_magnetizations(sys.model().particles.Ms));
+  sys.set_magnetizations(two_particle_magnetizations(sys.model().particles.Ms));
   const double le = sys.length_scale();
   // Particles pressed towards contact so that WCA acts too.
   Eigen::Matrix3Xd x = perturbed(sys.lattice().positions, 0.05 * le, 21);

@@ -43,7 +43,7 @@ std::vector<Eigen::Matrix3Xd> states(const lat::Lattice& l) {
 }
 
 // max |a - b| / max |b|.
-double relative(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
+double relative_max_error(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
   return (a - b).cwiseAbs().maxCoeff() / b.cwiseAbs().maxCoeff();
 }
 
@@ -67,7 +67,9 @@ TEST(MessElasticHessian, SpringProductMatchesDifferencesOfTheGradient) {
       mess::add_spring_gradient(l.springs, y, g);
       return g;
     };
-    EXPECT_LT(relative(hv, difference_of_gradients(gradient, x, v, 1e-6 * l.element_length)), 1e-7);
+    EXPECT_LT(
+        relative_max_error(hv, difference_of_gradients(gradient, x, v, 1e-6 * l.element_length)),
+        1e-7);
   }
 }
 
@@ -84,8 +86,9 @@ TEST(MessElasticHessian, VolumeProductMatchesDifferencesOfTheGradient) {
         mess::add_volume_gradient(l.elements, l.polymer.kappa, l.element_length, y, g, factor);
         return g;
       };
-      EXPECT_LT(relative(hv, difference_of_gradients(gradient, x, v, 1e-6 * l.element_length)),
-                1e-7)
+      EXPECT_LT(
+          relative_max_error(hv, difference_of_gradients(gradient, x, v, 1e-6 * l.element_length)),
+          1e-7)
           << "factor " << factor;
     }
   }
@@ -164,5 +167,5 @@ TEST(MessWcaHessian, PairProductMatchesDifferencesOfTheGradient) {
       (mm::wca_gradient(model, c + h * v.centres) - mm::wca_gradient(model, c - h * v.centres)) /
       (2.0 * h);
   EXPECT_GT(fd.cwiseAbs().maxCoeff(), 0.0);
-  EXPECT_LT(relative(hv.centres, fd), 1e-6);
+  EXPECT_LT(relative_max_error(hv.centres, fd), 1e-6);
 }

@@ -14,7 +14,10 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "../../support/dissertation_values.hpp"
+#include "../support/dissertation_particles.hpp"
 #include "../support/finite_differences.hpp"
+#include "../support/mess_test_support.hpp"
 #include "mresim/core/constants.hpp"
 #include "mresim/mess/magnetization/self_consistent.hpp"
 
@@ -22,23 +25,14 @@ namespace mm = mresim::magnetism;
 
 namespace {
 
-const mm::MagneticParticles kParticles{};  // R = 1.5 um, chi0 = 70, Ms = 1.6e6 A/m
-const double kR = kParticles.radius;
-const double kMs = kParticles.Ms;
-
-Eigen::Vector3d tesla(double bx, double by, double bz) {
-  return Eigen::Vector3d(bx, by, bz) / mresim::kMu0;
-}
-
-Eigen::Matrix3Xd centres_in_radii(std::initializer_list<Eigen::Vector3d> columns) {
-  Eigen::Matrix3Xd c(3, static_cast<Eigen::Index>(columns.size()));
-  int k = 0;
-  for (const Eigen::Vector3d& v : columns) c.col(k++) = v * kR;
-  return c;
-}
+using mresim::mess::testing::centres_in_radii;
+using mresim::mess::testing::kParticles;  // R = 1.5 um, chi0 = 70, Ms = 1.6e6 A/m
+using mresim::mess::testing::tesla;
+using mresim::testing::kMs;
+using mresim::testing::kR;
 
 // Arbitrary (not self-consistent) magnetizations below Ms.
-Eigen::Matrix3Xd some_magnetizations(Eigen::Index n) {
+Eigen::Matrix3Xd magnetizations_below_ms(Eigen::Index n) {
   Eigen::Matrix3Xd M(3, n);
   for (Eigen::Index i = 0; i < n; ++i) {
     const double t = static_cast<double>(i);
@@ -55,8 +49,7 @@ Eigen::Matrix3Xd numeric_gradient(const std::function<double(const Eigen::Matrix
 
 // Spread-out, near-contact (gaps 0.03-0.2 R, inside the WCA range) and overlapping (2.0 R
 // < r_min = 2.067 R) configurations.
-const Eigen::Matrix3Xd kLoose =
-    centres_in_radii({{0.0, 0.0, 0.0}, {3.4, 0.5, -0.3}, {-0.8, 3.3, 1.0}, {1.2, -1.1, 3.5}});
+using mresim::mess::testing::kLoose;
 const Eigen::Matrix3Xd kNear =
     centres_in_radii({{0.0, 0.0, 0.0}, {2.1, 0.2, -0.1}, {0.5, 2.08, 0.6}, {2.4, 1.9, 1.2}});
 const Eigen::Matrix3Xd kPressed =
@@ -82,7 +75,7 @@ double relative(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
 TEST(ParticleMagneticEnergy, DipoleGradientMatchesFiniteDifferences) {
   const mm::MagneticModel model = model_at(tesla(0.0, 0.0, 0.1));
   for (const Configuration& k : kConfigurations) {
-    const Eigen::Matrix3Xd M = some_magnetizations(k.centres->cols());
+    const Eigen::Matrix3Xd M = magnetizations_below_ms(k.centres->cols());
     const auto energy = [&](const Eigen::Matrix3Xd& c) { return mm::dipole_energy(model, c, M); };
     const Eigen::Matrix3Xd analytic = mm::dipole_gradient(model, *k.centres, M);
     EXPECT_LT(relative(numeric_gradient(energy, *k.centres, 1e-5 * kR), analytic), 1e-8) << k.name;
@@ -95,7 +88,7 @@ TEST(ParticleMagneticEnergy, DipoleGradientMatchesFiniteDifferences) {
 TEST(ParticleMagneticEnergy, DipoleGradientIsMinusEq478) {
   const mm::MagneticModel model = model_at(Eigen::Vector3d::Zero());
   const Eigen::Matrix3Xd c = centres_in_radii({{0.0, 0.0, 0.0}, {1.1, -2.0, 0.9}});
-  const Eigen::Matrix3Xd M = some_magnetizations(2);
+  const Eigen::Matrix3Xd M = magnetizations_below_ms(2);
   const double V = kParticles.volume();
   const Eigen::Vector3d mi = V * M.col(0), mj = V * M.col(1);
   const Eigen::Vector3d r = c.col(0) - c.col(1);
@@ -183,7 +176,7 @@ TEST(ParticleMagneticEnergy, ZeemanAndSelfEnergyHaveNoPositionalGradient) {
     mm::MagneticModel model = model_at(tesla(0.1, -0.2, 0.3));
     model.self_energy = form;
     for (const Configuration& k : kConfigurations) {
-      const Eigen::Matrix3Xd M = some_magnetizations(k.centres->cols());
+      const Eigen::Matrix3Xd M = magnetizations_below_ms(k.centres->cols());
       const auto zeeman = [&](const Eigen::Matrix3Xd& c) { return mm::zeeman_energy(model, c, M); };
       const auto self = [&](const Eigen::Matrix3Xd& c) { return mm::self_energy(model, c, M); };
       EXPECT_EQ(numeric_gradient(zeeman, *k.centres, 1e-5 * kR).norm(), 0.0);
@@ -197,7 +190,7 @@ TEST(ParticleMagneticEnergy, ZeemanAndSelfEnergyHaveNoPositionalGradient) {
 TEST(ParticleMagneticEnergy, ZeemanAndSelfEnergyValues) {
   const Eigen::Vector3d H = tesla(0.1, -0.2, 0.3);
   mm::MagneticModel model = model_at(H);
-  const Eigen::Matrix3Xd M = some_magnetizations(3);
+  const Eigen::Matrix3Xd M = magnetizations_below_ms(3);
   const Eigen::Matrix3Xd c = kPressed;
   const double V = kParticles.volume();
   const double chi = kParticles.chi0;
@@ -252,7 +245,7 @@ Relaxed relaxed(const Eigen::Matrix3Xd& c, const mm::MagneticModel& model,
   return r;
 }
 
-mm::MagnetizationOptions tight() {
+mm::MagnetizationOptions tight_to_1e13() {
   mm::MagnetizationOptions o;
   o.atol = 1e-13;
   o.rtol = 0.0;
@@ -276,7 +269,7 @@ TEST(ParticleMagneticEnergy, EnvelopeTheoremWithTheConsistentSelfEnergy) {
   for (const Case& k : cases) {
     mm::MagneticModel model = model_at(k.field);
     model.demagnetization = k.demagnetization;
-    const Relaxed e = relaxed(*k.centres, model, tight());
+    const Relaxed e = relaxed(*k.centres, model, tight_to_1e13());
     const Eigen::Matrix3Xd partial = mm::magnetic_gradient(model, *k.centres, e.history);
     const Eigen::Matrix3Xd total = numeric_gradient(
         [&](const Eigen::Matrix3Xd& c) { return e.energy(c); }, *k.centres, 1e-5 * kR);
@@ -301,7 +294,7 @@ TEST(ParticleMagneticEnergy, EnvelopeTheoremOnTheFallbackTriple) {
   const Eigen::Matrix3Xd triple =
       centres_in_radii({{0.0, 0.0, 0.0}, {-1.39, 0.04, -1.73}, {-2.79, -0.10, -0.15}});
   const mm::MagneticModel model = model_at(tesla(-0.036, -0.043, -0.045));
-  const Relaxed e = relaxed(triple, model, tight());
+  const Relaxed e = relaxed(triple, model, tight_to_1e13());
   const Eigen::Matrix3Xd partial = mm::magnetic_gradient(model, triple, e.history);
   const Eigen::Matrix3Xd total =
       numeric_gradient([&](const Eigen::Matrix3Xd& c) { return e.energy(c); }, triple, 1e-5 * kR);
@@ -313,7 +306,7 @@ TEST(ParticleMagneticEnergy, EnvelopeTheoremOnTheFallbackTriple) {
 TEST(ParticleMagneticEnergy, LinearizedSelfEnergyIsNotThePotentialOfTheForces) {
   mm::MagneticModel model = model_at(tesla(0.0, 0.03, 0.04));
   model.self_energy = mm::SelfEnergyForm::linearized;
-  const Relaxed e = relaxed(kNear, model, tight());
+  const Relaxed e = relaxed(kNear, model, tight_to_1e13());
   const Eigen::Matrix3Xd partial = mm::magnetic_gradient(model, kNear, e.history);
   const Eigen::Matrix3Xd total =
       numeric_gradient([&](const Eigen::Matrix3Xd& c) { return e.energy(c); }, kNear, 1e-5 * kR);
@@ -322,7 +315,7 @@ TEST(ParticleMagneticEnergy, LinearizedSelfEnergyIsNotThePotentialOfTheForces) {
 
 TEST(ParticleMagneticEnergy, BreakdownAndShapeChecks) {
   const mm::MagneticModel model = model_at(tesla(0.0, 0.0, 0.2));
-  const Eigen::Matrix3Xd M = some_magnetizations(4);
+  const Eigen::Matrix3Xd M = magnetizations_below_ms(4);
   const mm::MagneticEnergyBreakdown e = mm::magnetic_energies(model, kNear, M);
   EXPECT_DOUBLE_EQ(e.total(), e.zeeman + e.dipole + e.self + e.wca);
   EXPECT_DOUBLE_EQ(e.dipole, mm::dipole_energy(model, kNear, M));
@@ -330,7 +323,7 @@ TEST(ParticleMagneticEnergy, BreakdownAndShapeChecks) {
   EXPECT_GT(e.wca, 0.0);
   EXPECT_TRUE(mm::magnetic_gradient(model, kNear, M)
                   .isApprox(mm::dipole_gradient(model, kNear, M) + mm::wca_gradient(model, kNear)));
-  EXPECT_THROW((void)mm::dipole_energy(model, kNear, some_magnetizations(3)),
+  EXPECT_THROW((void)mm::dipole_energy(model, kNear, magnetizations_below_ms(3)),
                std::invalid_argument);
   EXPECT_THROW((void)mm::WcaParameters::from_radius(kR, -1.0), std::invalid_argument);
   EXPECT_THROW((void)mm::dipole_gradient(model, mm::PairList{{0, 5, Eigen::Vector3d::Ones()}}, M),
