@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "mresim/mess/terms/cell_rows.hpp"
 #include "mresim/mess/terms/elastic_formulas.hpp"
 #include "mresim/mess/terms/grid_stencil.hpp"
 #include "mresim/mess/terms/spring_rows.hpp"
@@ -15,8 +16,6 @@
 namespace mresim::mess {
 
 namespace {
-
-using Map3 = Eigen::Map<const Eigen::Vector3d>;
 
 using Sums = std::array<double, 4>;
 
@@ -112,10 +111,11 @@ ElasticEnergies DistributedElastic::evaluate(Vec positions, Vec gradient) const 
   check_petsc(VecGetArrayRead(local_, &x), "VecGetArrayRead");
   const NodeBox cells = cells_touching(d.owned(), d.shape());
   const bool want_gradient = gradient != nullptr;
-  const Sums cell_total = evaluate_cells(x, cells, want_gradient);
+  load_components(x);
+  const Sums cell_total = evaluate_cells(cells, want_gradient);
   PetscScalar* g = nullptr;
   if (want_gradient) check_petsc(VecGetArray(gradient, &g), "VecGetArray");
-  const Sums node_total = evaluate_nodes(x, cells, g);
+  const Sums node_total = evaluate_nodes(cells, g);
   if (want_gradient) check_petsc(VecRestoreArray(gradient, &g), "VecRestoreArray");
   check_petsc(VecRestoreArrayRead(local_, &x), "VecRestoreArrayRead");
 
@@ -125,41 +125,58 @@ ElasticEnergies DistributedElastic::evaluate(Vec positions, Vec gradient) const 
   return {total[0], total[1], total[2], total[3]};
 }
 
-DistributedElastic::Sums DistributedElastic::evaluate_cells(const PetscScalar* x,
-                                                            const NodeBox& cells,
+DistributedElastic::Sums DistributedElastic::evaluate_cells(const NodeBox& cells,
                                                             bool want_gradient) const {
   const NodeBox& owned = decomposition_.owned();
-  const NodeBox& ghosted = decomposition_.ghosted();
-  const auto at = [&](int ix, int iy, int iz) { return Map3(x + 3 * ghosted.offset(ix, iy, iz)); };
-
   // Cells: energy of the owned ones (lower corner owned), gradient coefficients of all that
-  // touch an owned node. Lines along z, as the nodes.
-  if (want_gradient) cell_terms_.resize(static_cast<std::size_t>(9 * cells.node_count()));
+  // touch an owned node. One z-line of cells at a time, one SIMD lane per cell
+  // (terms/cell_rows.hpp): the same operations per cell as elastic::cell_value, so the
+  // coefficients and energies are bitwise its.
   const std::int64_t cell_lines = std::int64_t{cells.size[0]} * cells.size[1];
+  const std::int64_t height = cells.size[2];
+  cell_terms_.resize(static_cast<std::size_t>(9 * cells.node_count()));
+  cell_scratch_.resize(static_cast<std::size_t>(omp_get_max_threads() * 2 * height));
   std::vector<Sums> cell_sums(static_cast<std::size_t>(cell_lines), Sums{});
-#pragma omp parallel for schedule(static)
-  for (std::int64_t line = 0; line < cell_lines; ++line) {
-    const int cx = cells.lower[0] + static_cast<int>(line % cells.size[0]);
-    const int cy = cells.lower[1] + static_cast<int>(line / cells.size[0]);
-    Sums& sums = cell_sums[static_cast<std::size_t>(line)];
-    for (int cz = cells.lower[2]; cz < cells.lower[2] + cells.size[2]; ++cz) {
-      const bool counted = owned.contains(cx, cy, cz);
-      if (!counted && !want_gradient) continue;
-      lattice::CellVertices vertices;
-      for (int v = 0; v < 8; ++v) {
-        const std::array<int, 3> o = lattice::vertex_offset(v);
-        vertices[static_cast<std::size_t>(v)] = at(cx + o[0], cy + o[1], cz + o[2]);
+#pragma omp parallel
+  {
+    double* const energy = cell_scratch_.data() + omp_get_thread_num() * 2 * height;
+    double* const rounding = energy + height;
+#pragma omp for schedule(static)
+    for (std::int64_t line = 0; line < cell_lines; ++line) {
+      const int cx = cells.lower[0] + static_cast<int>(line % cells.size[0]);
+      const int cy = cells.lower[1] + static_cast<int>(line / cells.size[0]);
+      const bool owned_line = owned.contains(cx, cy, owned.lower[2]);
+      if ((!owned_line && !want_gradient) || height == 0) continue;
+      cell_rows::Corners corners{};
+      for (std::size_t v = 0; v < 8; ++v) {
+        const std::array<int, 3> o = lattice::vertex_offset(static_cast<int>(v));
+        const spring_rows::Components c = components(
+            decomposition_.ghosted().offset(cx + o[0], cy + o[1], cells.lower[2] + o[2]));
+        corners.x[v] = c.x;
+        corners.y[v] = c.y;
+        corners.z[v] = c.z;
       }
-      double* t = want_gradient ? cell_terms_.data() + 9 * cells.offset(cx, cy, cz) : nullptr;
-      const elastic::CellValue value =
-          elastic::cell_value(vertices, kappa_, cell_volume_, volume_factor_, t);
-      if (counted) {
-        sums[1] += value.energy;
-        sums[3] += value.rounding;
+      cell_rows::coefficients(height, corners, kappa_, cell_volume_, volume_factor_,
+                              line_terms(line, height), energy, rounding);
+      if (!owned_line) continue;
+      Sums& sums = cell_sums[static_cast<std::size_t>(line)];
+      const int z_begin = std::max(cells.lower[2], owned.lower[2]);
+      const int z_end = std::min(cells.lower[2] + cells.size[2], owned.lower[2] + owned.size[2]);
+      for (int cz = z_begin; cz < z_end; ++cz) {
+        sums[1] += energy[cz - cells.lower[2]];
+        sums[3] += rounding[cz - cells.lower[2]];
       }
     }
   }
   return add_in_order(cell_sums);
+}
+
+cell_rows::Coefficients<double*> DistributedElastic::line_terms(std::int64_t line,
+                                                                std::int64_t height) const {
+  cell_rows::Coefficients<double*> t{};
+  double* const first = cell_terms_.data() + 9 * line * height;
+  for (std::size_t k = 0; k < 9; ++k) t[k] = first + static_cast<std::int64_t>(k) * height;
+  return t;
 }
 
 spring_rows::Components DistributedElastic::components(std::int64_t node) const {
@@ -247,40 +264,60 @@ void DistributedElastic::line_gradient(int ix, int iy, const NodeBox& cells, dou
                                        double* gz, PetscScalar* g) const {
   const lattice::GridShape& shape = decomposition_.shape();
   const NodeBox& owned = decomposition_.owned();
+  const int owned_z_begin = owned.lower[2];
+  const int owned_z_end = owned.lower[2] + owned.size[2];
   line_spring_gradient(ix, iy, gx, gy, gz);
-  for (int iz = owned.lower[2]; iz < owned.lower[2] + owned.size[2]; ++iz) {
-    const std::int64_t k = iz - owned.lower[2];
-    Eigen::Vector3d sum(gx[k], gy[k], gz[k]);
-    for (const auto& [dx, dy, dz] : kCellsOfNode) {
-      const int cx = ix - dx;
-      const int cy = iy - dy;
-      const int cz = iz - dz;
-      if (cx < 0 || cx >= shape.nx() - 1 || cy < 0 || cy >= shape.ny() - 1 || cz < 0 ||
-          cz >= shape.nz() - 1) {
-        continue;
-      }
-      sum += elastic::vertex_gradient(cell_terms_.data() + 9 * cells.offset(cx, cy, cz),
-                                      2 * dx + 4 * dy + dz);
-    }
-    Eigen::Map<Eigen::Vector3d>(g + 3 * owned.offset(ix, iy, iz)) = sum;
+  // Then each node's cells in CellStencil's order, one offset at a time along the line: the
+  // node is local vertex 2 dx + 4 dy + dz of cell (ix - dx, iy - dy, iz - dz), signs by dx, dy,
+  // dz (elastic::vertex_gradient).
+  for (const auto& [dx, dy, dz] : kCellsOfNode) {
+    const int cx = ix - dx;
+    const int cy = iy - dy;
+    if (cx < 0 || cx >= shape.nx() - 1 || cy < 0 || cy >= shape.ny() - 1) continue;
+    const int lo = std::max(owned_z_begin, dz);                 // cz = iz - dz >= 0
+    const int hi = std::min(owned_z_end, shape.nz() - 1 + dz);  // cz < nz - 1
+    if (lo >= hi) continue;
+    const std::int64_t line =
+        (cx - cells.lower[0]) + std::int64_t{cells.size[0]} * (cy - cells.lower[1]);
+    const cell_rows::Coefficients<double*> terms = line_terms(line, cells.size[2]);
+    cell_rows::Coefficients<const double*> t{};
+    for (std::size_t k = 0; k < 9; ++k) t[k] = terms[k] + (lo - dz - cells.lower[2]);
+    const std::int64_t k = lo - owned_z_begin;
+    cell_rows::add_vertex_gradient(hi - lo, t, dx == 1 ? 1.0 : -1.0, dy == 1 ? 1.0 : -1.0,
+                                   dz == 1 ? 1.0 : -1.0, gx + k, gy + k, gz + k);
+  }
+  for (int iz = owned_z_begin; iz < owned_z_end; ++iz) {
+    const std::int64_t k = iz - owned_z_begin;
+    PetscScalar* const node = g + 3 * owned.offset(ix, iy, iz);
+    node[0] = gx[k];
+    node[1] = gy[k];
+    node[2] = gz[k];
   }
 }
 
-DistributedElastic::Sums DistributedElastic::evaluate_nodes(const PetscScalar* x,
-                                                            const NodeBox& cells,
+void DistributedElastic::load_components(const PetscScalar* x) const {
+  const std::int64_t nodes = decomposition_.ghosted().node_count();
+  components_.resize(static_cast<std::size_t>(3 * nodes));
+  double* const c = components_.data();
+#pragma omp parallel for schedule(static)
+  for (std::int64_t n = 0; n < nodes; ++n) {
+    c[n] = x[3 * n];
+    c[nodes + n] = x[3 * n + 1];
+    c[2 * nodes + n] = x[3 * n + 2];
+  }
+}
+
+DistributedElastic::Sums DistributedElastic::evaluate_nodes(const NodeBox& cells,
                                                             PetscScalar* g) const {
   const NodeBox& owned = decomposition_.owned();
   const NodeBox& ghosted = decomposition_.ghosted();
-  const std::int64_t nodes = ghosted.node_count();
   const std::int64_t row_lines = ghosted.size[0];
-  components_.resize(static_cast<std::size_t>(3 * nodes));
   tensions_.resize(static_cast<std::size_t>(2 * row_lines * 13 * ghosted.size[2]));
   std::vector<Sums> line_sums(static_cast<std::size_t>(row_lines * ghosted.size[1]), Sums{});
   // Per thread: a line's energies and roundings, and an owned line's gradient.
   const std::int64_t scratch_per_thread =
       2 * std::int64_t{ghosted.size[2]} + 3 * std::int64_t{owned.size[2]};
   row_scratch_.resize(static_cast<std::size_t>(omp_get_max_threads() * scratch_per_thread));
-  double* const c = components_.data();
 
 #pragma omp parallel
   {
@@ -289,13 +326,6 @@ DistributedElastic::Sums DistributedElastic::evaluate_nodes(const PetscScalar* x
     double* const gx = rounding + ghosted.size[2];
     double* const gy = gx + owned.size[2];
     double* const gz = gy + owned.size[2];
-    // The ghosted positions as three component arrays, as the row formulas take them.
-#pragma omp for schedule(static)
-    for (std::int64_t n = 0; n < nodes; ++n) {
-      c[n] = x[3 * n];
-      c[nodes + n] = x[3 * n + 1];
-      c[2 * nodes + n] = x[3 * n + 2];
-    }
     for (int iy = ghosted.lower[1]; iy < ghosted.lower[1] + ghosted.size[1]; ++iy) {
 #pragma omp for schedule(static)
       for (std::int64_t l = 0; l < row_lines; ++l) {

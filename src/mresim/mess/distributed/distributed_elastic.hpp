@@ -33,6 +33,7 @@
 
 #include "mresim/mess/distributed/lattice_decomposition.hpp"
 #include "mresim/mess/lattice/lattice.hpp"
+#include "mresim/mess/terms/cell_rows.hpp"
 #include "mresim/mess/terms/elastic_terms.hpp"
 #include "mresim/mess/terms/spring_rows.hpp"
 
@@ -62,12 +63,20 @@ class DistributedElastic {
   // Springs, volume and their rounding scales (ElasticEnergies' order) of one process.
   using Sums = std::array<double, 4>;
 
-  // The cells touching the owned nodes (`cells`, from the ghosted positions x): the energy of
-  // the owned ones (lower corner owned) and, if asked, every one's gradient coefficients.
-  Sums evaluate_cells(const PetscScalar* x, const NodeBox& cells, bool want_gradient) const;
+  // Copies the ghosted positions x (3 per node) into the three component arrays that the row
+  // formulas read (components_).
+  void load_components(const PetscScalar* x) const;
+  // The cells touching the owned nodes (`cells`), z-line by z-line: the energy of the owned
+  // ones (lower corner owned) and every line's gradient coefficients that the gradient needs
+  // (all of them if want_gradient, else only the owned lines').
+  Sums evaluate_cells(const NodeBox& cells, bool want_gradient) const;
+  // The nine coefficient arrays of cell z-line `line` (cx - lower + size_x (cy - lower) in
+  // `cells`), each of the cells box's height, in cell_terms_.
+  [[nodiscard]] cell_rows::Coefficients<double*> line_terms(std::int64_t line,
+                                                            std::int64_t height) const;
   // The owned nodes: the energy of their forward springs and, if g is not null, the gradient
   // (springs, then cells) at each; row by row (one y), each row's lines in parallel.
-  Sums evaluate_nodes(const PetscScalar* x, const NodeBox& cells, PetscScalar* g) const;
+  Sums evaluate_nodes(const NodeBox& cells, PetscScalar* g) const;
   // The ghosted z-line (ix, iy): the tensions of its forward springs with both ends in the
   // ghosted box (tensions_at), and, on an owned line, the owned springs' energies and rounding
   // scales added to sums[0] and sums[2]. energy, rounding: scratch of the ghosted box's height.
@@ -95,13 +104,15 @@ class DistributedElastic {
   // the lattice.
   std::vector<std::uint8_t> spring_class_;
   Vec local_ = nullptr;                     // positions of the ghosted box
-  mutable std::vector<double> cell_terms_;  // 9 per cell touching an owned node
+  // 9 per cell touching an owned node: per z-line of cells, nine arrays along z (line_terms).
+  mutable std::vector<double> cell_terms_;
   // One evaluation's scratch: the ghosted positions as x, y and z arrays; the forward springs'
   // tensions of two rows of z-lines (tensions_at); per thread a line's energies and an owned
   // line's gradient.
   mutable std::vector<double> components_;
   mutable std::vector<double> tensions_;
   mutable std::vector<double> row_scratch_;
+  mutable std::vector<double> cell_scratch_;  // per thread a cell line's energies and roundings
 };
 
 }  // namespace mresim::mess
