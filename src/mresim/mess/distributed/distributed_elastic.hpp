@@ -103,7 +103,7 @@ class DistributedElastic {
   // o x (ghosted nodes) + n: index into stiffness_, or kNoSpring where the neighbour is outside
   // the lattice.
   std::vector<std::uint8_t> spring_class_;
-  Vec local_ = nullptr;                     // positions of the ghosted box
+  Vec local_ = nullptr;  // positions of the ghosted box
   // 9 per cell touching an owned node: per z-line of cells, nine arrays along z (line_terms).
   mutable std::vector<double> cell_terms_;
   // One evaluation's scratch: the ghosted positions as x, y and z arrays; the forward springs'

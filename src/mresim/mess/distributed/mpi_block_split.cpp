@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "mresim/mess/solvers/amg_preconditioner.hpp"
@@ -60,6 +61,17 @@ void MpiBlockSplit::share_entries(Eigen::VectorXd& v) const {
   }
   MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, v.data(), counts.data(), starts.data(),
                  MPI_DOUBLE, comm_);
+}
+
+void MpiBlockSplit::share_from(int owner, std::vector<double>& values) const {
+  if (owner < 0 || owner >= size_) {
+    throw std::invalid_argument("MpiBlockSplit::share_from: owner " + std::to_string(owner) +
+                                " is not a rank of " + std::to_string(size_) + " processes");
+  }
+  long long length = rank_ == owner ? static_cast<long long>(values.size()) : 0;
+  MPI_Bcast(&length, 1, MPI_LONG_LONG, owner, comm_);
+  values.resize(static_cast<std::size_t>(length));
+  MPI_Bcast(values.data(), as_count(static_cast<Eigen::Index>(length)), MPI_DOUBLE, owner, comm_);
 }
 
 }  // namespace mresim::mess

@@ -17,6 +17,9 @@ class MpiBlockSplit final : public detail::BlockSplit {
   [[nodiscard]] detail::OwnedBlocks owned(Eigen::Index n) const override;
   void share_block_sums(std::vector<double>& block_sums, Eigen::Index n) const override;
   void share_entries(Eigen::VectorXd& v) const override;
+  [[nodiscard]] int rank() const override { return rank_; }
+  [[nodiscard]] int processes() const override { return size_; }
+  void share_from(int owner, std::vector<double>& values) const override;
 
  private:
   [[nodiscard]] detail::OwnedBlocks owned_by(int rank, Eigen::Index n) const;

@@ -46,6 +46,14 @@ class BlockSplit {
   // Collective. `v` is a whole vector with this process's entries set; on return every entry
   // is set, on every process, to the value its owner had.
   virtual void share_entries(Eigen::VectorXd& v) const = 0;
+
+  // Work split by whole items rather than blocks (the multilevel correction's levels, each
+  // built by one process): this process's rank among the split's processes, and their number.
+  [[nodiscard]] virtual int rank() const = 0;
+  [[nodiscard]] virtual int processes() const = 0;
+  // Collective. On return every process's `values` are those of process `owner` (its length
+  // too).
+  virtual void share_from(int owner, std::vector<double>& values) const = 0;
 };
 
 }  // namespace mresim::mess::detail

@@ -319,12 +319,16 @@ class Minimisation {
       multilevel = options.lbfgs_preconditioner == LbfgsPreconditioner::multilevel ||
                    (options.lbfgs_preconditioner == LbfgsPreconditioner::automatic &&
                     system.node_count() >= kMultilevelMinimumNodes);
+      // Over MPI processes they share the multilevel correction's build (docs/mpi.md).
+      const detail::BlockSplit* processes =
+          options.distributed != nullptr ? options.distributed->vector_split().get() : nullptr;
       preconditioner_ =
           options.preconditioner_cache != nullptr
-              ? options.preconditioner_cache->get(system, map, force_scale, multilevel)
+              ? options.preconditioner_cache->get(system, map, force_scale, multilevel, processes)
               : std::make_shared<const RigidParticlePreconditioner>(
                     system, map, force_scale, multilevel,
-                    multilevel ? &system.positions() : nullptr);  // as the cache builds it
+                    multilevel ? &system.positions() : nullptr,  // as the cache builds it
+                    processes);
     }
     const bool single = options.lbfgs_history == LbfgsHistoryPrecision::single_precision ||
                         (options.lbfgs_history == LbfgsHistoryPrecision::automatic && multilevel);

@@ -129,7 +129,8 @@ constexpr int kNeighbours = kWidth * kWidth * kWidth;
 MultilevelCorrection::MultilevelCorrection(const lattice::Lattice& lattice,
                                            double volume_force_factor, const DofMap& map,
                                            double force_scale, const Eigen::Matrix3Xd* state,
-                                           Eigen::Index exact_limit) {
+                                           Eigen::Index exact_limit,
+                                           const detail::BlockSplit* processes) {
   if (exact_limit < 1) {
     throw std::invalid_argument("MultilevelCorrection: exact_limit " + std::to_string(exact_limit) +
                                 " must be at least 1");
@@ -137,7 +138,8 @@ MultilevelCorrection::MultilevelCorrection(const lattice::Lattice& lattice,
   fine_ = lattice.shape.nodes;
   own_dofs_ = map.own_dofs();
   build_levels(exact_limit);
-  assemble(lattice, volume_force_factor, lattice.element_length / force_scale, map, state);
+  assemble(lattice, volume_force_factor, lattice.element_length / force_scale, map, state,
+           processes);
 }
 
 Eigen::Index MultilevelCorrection::level_size(int level) const {
@@ -367,18 +369,44 @@ void add_stiffness(const lattice::Lattice& lattice, const Eigen::Matrix3Xd* stat
 
 }  // namespace
 
+namespace {
+
+// The process that builds each level when `processes` share the build: the levels in build
+// order (the coarsest, about twice the work of another, first), each to the process with the
+// least work so far (the lowest rank on a tie). The same on every process.
+std::vector<int> level_owners(std::int64_t count, int processes) {
+  std::vector<int> owner(static_cast<std::size_t>(count), 0);
+  std::vector<int> load(static_cast<std::size_t>(std::max(processes, 1)), 0);
+  for (std::int64_t order = 0; order < count; ++order) {
+    const std::int64_t li = count - 1 - order;
+    const auto least = static_cast<int>(std::min_element(load.begin(), load.end()) - load.begin());
+    owner[static_cast<std::size_t>(li)] = least;
+    load[static_cast<std::size_t>(least)] += order == 0 ? 2 : 1;
+  }
+  return owner;
+}
+
+}  // namespace
+
 void MultilevelCorrection::assemble(const lattice::Lattice& lattice, double volume_force_factor,
-                                    double scale, const DofMap& map,
-                                    const Eigen::Matrix3Xd* state) {
+                                    double scale, const DofMap& map, const Eigen::Matrix3Xd* state,
+                                    const detail::BlockSplit* processes) {
   // Each level sweeps all springs and cells, and the levels are independent: one thread per
   // level, so that each level's sums come in the same order whatever the thread count. The
   // coarsest level, which also sums its neighbour blocks, takes about as long as two others:
-  // it goes first, so that the other threads share the remaining levels meanwhile.
+  // it goes first, so that the other threads share the remaining levels meanwhile. Over
+  // several processes each builds its own levels (level_owners) and shares them.
   std::exception_ptr failure;
   const auto count = static_cast<std::int64_t>(levels_.size());
+  const bool shared = processes != nullptr && processes->processes() > 1;
+  const std::vector<int> owner = level_owners(count, shared ? processes->processes() : 1);
+  const int rank = shared ? processes->rank() : 0;
+  std::vector<double> coarsest;  // shared: the coarsest level's diagonal, then its blocks
+  std::vector<char> failed(static_cast<std::size_t>(count), 0);
 #pragma omp parallel for schedule(dynamic, 1) if (point_count(fine_) >= 20000)
   for (std::int64_t order = 0; order < count; ++order) {
     const std::int64_t li = count - 1 - order;
+    if (owner[static_cast<std::size_t>(li)] != rank) continue;
     try {
       Level& level = levels_[static_cast<std::size_t>(li)];
       const bool exact = li + 1 == count;
@@ -387,6 +415,10 @@ void MultilevelCorrection::assemble(const lattice::Lattice& lattice, double volu
                                fine_, level.points, map, exact);
       add_stiffness(lattice, state, map, volume_force_factor, scale, assembler);
       if (exact) {
+        if (shared) {
+          coarsest = assembler.diagonal();
+          coarsest.insert(coarsest.end(), assembler.blocks().begin(), assembler.blocks().end());
+        }
         factor_coarsest(level.points, assembler.diagonal(), assembler.blocks());
         continue;
       }
@@ -397,10 +429,58 @@ void MultilevelCorrection::assemble(const lattice::Lattice& lattice, double volu
       }
     } catch (...) {
 #pragma omp critical(mresim_multilevel_assembly)
-      failure = std::current_exception();
+      {
+        failure = std::current_exception();
+        failed[static_cast<std::size_t>(li)] = 1;
+      }
     }
   }
+  if (shared) share_levels(owner, *processes, coarsest, failed);
   if (failure) std::rethrow_exception(failure);
+}
+
+void MultilevelCorrection::share_levels(const std::vector<int>& owner,
+                                        const detail::BlockSplit& processes,
+                                        std::vector<double>& coarsest,
+                                        const std::vector<char>& failed) {
+  // Each level travels from its owner with one more value at the end: 1 if the owner built
+  // it, 0 if its build failed. Every process sees the same flags, so all stop sharing at the
+  // first failed level and fail alike (its owner with its own error, in assemble).
+  const int rank = processes.rank();
+  const std::size_t count = levels_.size();
+  for (std::size_t li = 0; li < count; ++li) {
+    const bool mine = owner[li] == rank;
+    const bool exact = li + 1 == count;
+    Level& level = levels_[li];
+    std::vector<double> values;
+    if (mine) {
+      if (exact) {
+        values = std::move(coarsest);
+      } else {
+        values.assign(level.inverse_diagonal.data(),
+                      level.inverse_diagonal.data() + level.inverse_diagonal.size());
+      }
+      values.push_back(failed[li] != 0 ? 0.0 : 1.0);
+    }
+    processes.share_from(owner[li], values);
+    if (values.empty() || values.back() != 1.0) {
+      if (mine) return;  // assemble rethrows the owner's own error
+      throw std::runtime_error("MultilevelCorrection: level " + std::to_string(li + 1) +
+                               " could not be built on process " + std::to_string(owner[li]) +
+                               " (the coarsest level's Hessian is singular if no rigid motion "
+                               "of the lattice is held)");
+    }
+    if (mine) continue;
+    values.pop_back();
+    const std::int64_t points = point_count(level.points);
+    if (!exact) {
+      level.inverse_diagonal = Eigen::Map<const Eigen::VectorXd>(values.data(), 3 * points);
+      continue;
+    }
+    const auto diagonal_end = values.begin() + 3 * points;
+    factor_coarsest(level.points, std::vector<double>(values.begin(), diagonal_end),
+                    std::vector<double>(diagonal_end, values.end()));
+  }
 }
 
 void MultilevelCorrection::factor_coarsest(const std::array<int, 3>& p,

@@ -40,6 +40,12 @@
 // 285k nodes on 2 threads. It depends on the lattice, the free coordinates, the force scale and
 // the state; a run builds one at each relaxation's starting state (PreconditionerCache,
 // preconditioner.hpp).
+//
+// Over MPI processes (a BlockSplit of more than one process, docs/mpi.md) the levels are
+// built by different processes, each level by one, the coarsest by the first, and shared
+// whole: every process then holds the same correction, bitwise the single-process one (each
+// level's sums come in the same order, and every process factors the same coarsest matrix).
+// Applying it is not split: every process applies it whole to the same whole vector.
 
 #include <Eigen/Core>
 #include <Eigen/SparseCholesky>
@@ -49,6 +55,7 @@
 #include <vector>
 
 #include "mresim/mess/lattice/lattice.hpp"
+#include "mresim/mess/solvers/block_split.hpp"
 #include "mresim/mess/system/constraints.hpp"
 
 namespace mresim::mess {
@@ -62,11 +69,13 @@ class MultilevelCorrection {
   // Throws std::invalid_argument if exact_limit < 1, std::runtime_error if the coarsest level
   // cannot be factored (no coordinate held, so A is singular: callers leave the correction out).
   // `state`: the positions (3 x N, m) at which the springs and cells are linearised
-  // (stiffness_terms.hpp); null: the reference lattice.
+  // (stiffness_terms.hpp); null: the reference lattice. `processes`: the processes that share
+  // the build (collective on them; every one must pass the same arguments), null: this one.
   MultilevelCorrection(const lattice::Lattice& lattice, double volume_force_factor,
                        const DofMap& map, double force_scale,
                        const Eigen::Matrix3Xd* state = nullptr,
-                       Eigen::Index exact_limit = kDefaultExactLimit);
+                       Eigen::Index exact_limit = kDefaultExactLimit,
+                       const detail::BlockSplit* processes = nullptr);
 
   // w += C v (v, w over the map's dofs). `map`: one with the same free coordinates as the
   // constructor's (PreconditionerCache keys on them); std::invalid_argument if its number of
@@ -101,7 +110,14 @@ class MultilevelCorrection {
   void build_levels(Eigen::Index exact_limit);
   static void add_restriction_terms(Axis& axis, int points);
   void assemble(const lattice::Lattice& lattice, double volume_force_factor, double scale,
-                const DofMap& map, const Eigen::Matrix3Xd* state);
+                const DofMap& map, const Eigen::Matrix3Xd* state,
+                const detail::BlockSplit* processes);
+  // Over several processes: each level's result from the process that built it (owner), sent
+  // to the others; `coarsest` holds the coarsest level's diagonal and blocks on its owner,
+  // `failed` the levels whose build failed here. If a level failed, the others throw
+  // std::runtime_error and its owner returns (to rethrow its own error).
+  void share_levels(const std::vector<int>& owner, const detail::BlockSplit& processes,
+                    std::vector<double>& coarsest, const std::vector<char>& failed);
   // The coarsest level's matrix from its diagonal and neighbour blocks (LevelAssembler), and
   // its LDL^T; throws std::runtime_error if it is singular.
   void factor_coarsest(const std::array<int, 3>& points, const std::vector<double>& diagonal,

@@ -14,7 +14,8 @@ namespace mresim::mess {
 RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& system,
                                                          const DofMap& map, double force_scale,
                                                          bool multilevel,
-                                                         const Eigen::Matrix3Xd* state) {
+                                                         const Eigen::Matrix3Xd* state,
+                                                         const detail::BlockSplit* processes) {
   const lattice::Lattice& lat = system.lattice();
   // Where the particles' rigid motions are taken: the state, or the reference lattice.
   const Eigen::Matrix3Xd& x = state != nullptr ? *state : lat.positions;
@@ -97,8 +98,9 @@ RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& syste
   }
   if (multilevel) {
     try {
-      multilevel_ =
-          std::make_unique<MultilevelCorrection>(lat, volume_force_factor, map, force_scale, state);
+      multilevel_ = std::make_unique<MultilevelCorrection>(
+          lat, volume_force_factor, map, force_scale, state,
+          MultilevelCorrection::kDefaultExactLimit, processes);
     } catch (const std::runtime_error&) {
       multilevel_.reset();  // nothing held: the coarse Hessian is singular (header)
     }
@@ -162,12 +164,13 @@ std::uint64_t preconditioner_key(const MessSystem& system, const DofMap& map, do
 }  // namespace
 
 std::shared_ptr<const RigidParticlePreconditioner> PreconditionerCache::get(
-    const MessSystem& system, const DofMap& map, double force_scale, bool multilevel) {
+    const MessSystem& system, const DofMap& map, double force_scale, bool multilevel,
+    const detail::BlockSplit* processes) {
   const std::uint64_t key = preconditioner_key(system, map, force_scale, multilevel);
   if (multilevel) {
     kept_.reset();  // before the new one is built: never two at once
     kept_ = std::make_shared<const RigidParticlePreconditioner>(system, map, force_scale, true,
-                                                                &system.positions());
+                                                                &system.positions(), processes);
     lattice_ = &system.lattice();
     key_ = key;
     ++builds_;

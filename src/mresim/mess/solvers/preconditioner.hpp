@@ -48,8 +48,11 @@ class RigidParticlePreconditioner {
   // (gradient in units of force_scale per l_e): D_scaled = D l_e / force_scale.
   // `state`: the positions (3 x N, m) at which springs and cells are linearised
   // (stiffness_terms.hpp) and the particles' rigid motions taken; null: the reference lattice.
+  // `processes`: the MPI processes that share the multilevel correction's build
+  // (multilevel_correction.hpp; collective on them), null: this process alone.
   RigidParticlePreconditioner(const MessSystem& system, const DofMap& map, double force_scale,
-                              bool multilevel = false, const Eigen::Matrix3Xd* state = nullptr);
+                              bool multilevel = false, const Eigen::Matrix3Xd* state = nullptr,
+                              const detail::BlockSplit* processes = nullptr);
 
   // P v. `map`: one with the same free coordinates and groups as the constructor's (as
   // PreconditionerCache hands out); the multilevel correction reads the lattice through it.
@@ -76,10 +79,10 @@ class RigidParticlePreconditioner {
 // one, so that two are never held at once (peak memory).
 class PreconditionerCache {
  public:
-  // The preconditioner for these arguments (see above).
-  std::shared_ptr<const RigidParticlePreconditioner> get(const MessSystem& system,
-                                                         const DofMap& map, double force_scale,
-                                                         bool multilevel);
+  // The preconditioner for these arguments (see above); `processes` as for the constructor.
+  std::shared_ptr<const RigidParticlePreconditioner> get(
+      const MessSystem& system, const DofMap& map, double force_scale, bool multilevel,
+      const detail::BlockSplit* processes = nullptr);
   int builds() const { return builds_; }
 
  private:
