@@ -135,11 +135,11 @@ DistributedElastic::Sums DistributedElastic::evaluate_cells(const NodeBox& cells
   const std::int64_t cell_lines = std::int64_t{cells.size[0]} * cells.size[1];
   const std::int64_t height = cells.size[2];
   cell_terms_.resize(static_cast<std::size_t>(9 * cells.node_count()));
-  cell_scratch_.resize(static_cast<std::size_t>(omp_get_max_threads() * 2 * height));
+  cell_scratch_.resize(static_cast<std::size_t>(std::int64_t{omp_get_max_threads()} * 2 * height));
   std::vector<Sums> cell_sums(static_cast<std::size_t>(cell_lines), Sums{});
 #pragma omp parallel
   {
-    double* const energy = cell_scratch_.data() + omp_get_thread_num() * 2 * height;
+    double* const energy = cell_scratch_.data() + std::int64_t{omp_get_thread_num()} * 2 * height;
     double* const rounding = energy + height;
 #pragma omp for schedule(static)
     for (std::int64_t line = 0; line < cell_lines; ++line) {

@@ -13,17 +13,19 @@
 // runs them, in SIMD rows along z (terms/spring_rows.hpp): each row of z-lines (one y) first
 // computes the tensions of its springs once, offset by offset, then the gradient of its owned
 // nodes from its own tensions (forward springs) and the previous row's (backward springs, which
-// start at most one y below), so only two rows' tensions are kept. The cells use
-// terms/elastic_formulas.hpp per cell. The energies are summed in another order (per grid line,
+// start at most one y below), so only two rows' tensions are kept. The cells run in SIMD rows
+// too (terms/cell_rows.hpp), along z-lines of cells from the same component arrays: each line's
+// gradient coefficients first, then each owned z-line adds its cells' parts after its springs',
+// in the single-process order. The energies are summed in another order (per grid line,
 // then over processes), so they agree with the single-process sums to rounding (relative 1e-15
 // or so), not bitwise.
 //
 // Memory per process: one byte per forward spring of its ghosted nodes (the spring's stiffness
 // as an index into a table of the lattice's distinct spring constants), 72 bytes per cell
 // touching its nodes (gradient coefficients), the ghosted positions as three component arrays
-// (24 bytes per node), two rows' tensions (13 doubles per node of two of its y-rows), and
-// PETSc's ghosted position vector. The set-up reads the whole lattice, which every process
-// builds today (docs/mpi.md: what is distributed so far and what is next).
+// (24 bytes per node), a cell line's energies per thread, two rows' tensions (13 doubles per node
+// of two of its y-rows), and PETSc's ghosted position vector. The set-up reads the whole lattice,
+// which every process builds today (docs/mpi.md: what is distributed so far and what is next).
 
 #include <petscvec.h>
 

@@ -455,7 +455,7 @@ void MultilevelCorrection::share_levels(const std::vector<int>& owner,
     std::vector<double> values;
     if (mine) {
       if (exact) {
-        values = std::move(coarsest);
+        values.swap(coarsest);  // the coarsest level is the last one shared
       } else {
         values.assign(level.inverse_diagonal.data(),
                       level.inverse_diagonal.data() + level.inverse_diagonal.size());
