@@ -9,11 +9,11 @@
 
 #include <Eigen/Core>
 #include <array>
-#include <random>
 #include <stdexcept>
 #include <vector>
 
 #include "../support/mess_test_support.hpp"
+#include "../support/multilevel_test_support.hpp"
 #include "mpi_test_support.hpp"
 #include "mresim/mess/distributed/mpi_block_split.hpp"
 #include "mresim/mess/profile/model_profile.hpp"
@@ -22,8 +22,12 @@
 
 namespace mess = mresim::mess;
 namespace lat = mresim::lattice;
+using mess::testing::apply_correction;
 using mess::testing::everywhere;
+using mess::testing::faces_held;
+using mess::testing::perturbed;
 using mess::testing::small_lattice;
+using mess::testing::uniform_random_vector;
 using mess::testing::world_size;
 
 namespace {
@@ -33,21 +37,6 @@ constexpr double kForceScale = 1e-9;  // N: any positive scale
 // (on three processes, one each).
 constexpr Eigen::Index kExactLimit = 200;
 
-Eigen::VectorXd random_vector(Eigen::Index n, unsigned seed) {
-  std::mt19937 gen(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Eigen::VectorXd v(n);
-  for (Eigen::Index i = 0; i < n; ++i) v[i] = u(gen);
-  return v;
-}
-
-Eigen::VectorXd apply(const mess::MultilevelCorrection& c, const mess::DofMap& map,
-                      const Eigen::VectorXd& v) {
-  Eigen::VectorXd w = Eigen::VectorXd::Zero(v.size());
-  c.add_to(map, v, w);
-  return w;
-}
-
 // Two seed-profile particles in a 16 x 16 x 24 cell lattice, every face held unless `free`.
 mess::MessSystem pair_system(bool free = false) {
   const mess::ModelProfile& profile = mess::model_profile("seed");
@@ -55,12 +44,9 @@ mess::MessSystem pair_system(bool free = false) {
       mess::MessSystem::make(small_lattice(profile, {16, 16, 24}, {{8, 8, 8}, {8, 8, 16}}),
                              Eigen::Vector3d::Zero(), profile);
   if (free) return sys;
-  mess::BoundaryConstraints held = mess::BoundaryConstraints::none(sys.node_count());
-  for (const lat::Face f : {lat::Face::left, lat::Face::right, lat::Face::front, lat::Face::back,
-                            lat::Face::bottom, lat::Face::top}) {
-    held.fix_face(sys.lattice().shape, f, sys.lattice().positions);
-  }
-  sys.set_constraints(held);
+  sys.set_constraints(
+      faces_held(sys.lattice(), {lat::Face::left, lat::Face::right, lat::Face::front,
+                                 lat::Face::back, lat::Face::bottom, lat::Face::top}));
   return sys;
 }
 
@@ -73,10 +59,7 @@ TEST(DistributedMultilevel, BuildSharedOverProcessesIsBitwiseTheSingleProcessOne
   const double factor = sys.settings().elastic.volume_force_factor;
   const mess::MpiBlockSplit processes(MPI_COMM_WORLD);
   // At rest, and linearised at a strained state (every node moved by up to 0.05 l_e).
-  Eigen::Matrix3Xd state = l.positions;
-  std::mt19937 gen(11);
-  std::uniform_real_distribution<double> u(-0.05, 0.05);
-  for (Eigen::Index i = 0; i < state.size(); ++i) state.data()[i] += u(gen) * l.element_length;
+  const Eigen::Matrix3Xd state = perturbed(l.positions, 0.05 * l.element_length);
   const std::array<const Eigen::Matrix3Xd*, 2> states = {nullptr, &state};
   for (const Eigen::Matrix3Xd* at : states) {
     const mess::MultilevelCorrection alone(l, factor, map, kForceScale, at, kExactLimit);
@@ -85,10 +68,10 @@ TEST(DistributedMultilevel, BuildSharedOverProcessesIsBitwiseTheSingleProcessOne
     ASSERT_GE(shared.levels(), 3);
     ASSERT_TRUE(everywhere(shared.levels() == alone.levels()));
     for (const unsigned seed : {1U, 2U}) {
-      const Eigen::VectorXd v = random_vector(map.size(), seed);
-      const Eigen::VectorXd expected = apply(alone, map, v);
+      const Eigen::VectorXd v = uniform_random_vector(map.size(), seed);
+      const Eigen::VectorXd expected = apply_correction(alone, map, v);
       EXPECT_GT(v.dot(expected), 0.0);
-      EXPECT_TRUE(everywhere(apply(shared, map, v) == expected))
+      EXPECT_TRUE(everywhere(apply_correction(shared, map, v) == expected))
           << "seed " << seed << (at == nullptr ? " at rest" : " at the strained state");
     }
   }

@@ -14,32 +14,21 @@
 #include <vector>
 
 #include "../support/mess_test_support.hpp"
+#include "../support/multilevel_test_support.hpp"
 #include "mresim/mess/solvers/minimiser.hpp"
 #include "mresim/mess/solvers/preconditioner.hpp"
 
 namespace mess = mresim::mess;
 namespace lat = mresim::lattice;
+using mess::testing::apply_correction;
+using mess::testing::faces_held;
 using mess::testing::small_lattice;
 using mess::testing::tesla;
+using mess::testing::uniform_random_vector;
 
 namespace {
 
 constexpr double kForceScale = 1e-9;  // N: any positive scale
-
-Eigen::VectorXd uniform_random_vector(Eigen::Index n, unsigned seed) {
-  std::mt19937 gen(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Eigen::VectorXd v(n);
-  for (Eigen::Index i = 0; i < n; ++i) v[i] = u(gen);
-  return v;
-}
-
-Eigen::VectorXd apply(const mess::MultilevelCorrection& c, const mess::DofMap& map,
-                      const Eigen::VectorXd& v) {
-  Eigen::VectorXd w = Eigen::VectorXd::Zero(v.size());
-  c.add_to(map, v, w);
-  return w;
-}
 
 // The planes of every level along one axis of n lattice planes: every second plane of the
 // finer level and its last one.
@@ -174,13 +163,6 @@ Eigen::MatrixXd stiffness_matrix(const lat::Lattice& l, const Eigen::Matrix3Xd& 
   return h;
 }
 
-mess::BoundaryConstraints faces_held(const lat::Lattice& l,
-                                     std::initializer_list<lat::Face> faces) {
-  mess::BoundaryConstraints c = mess::BoundaryConstraints::none(l.node_count());
-  for (const lat::Face f : faces) c.fix_face(l.shape, f, l.positions);
-  return c;
-}
-
 }  // namespace
 
 // 9 x 9 x 9 nodes with a stiff particle, two faces held: levels of 5^3 and 3^3 points scaled by
@@ -204,7 +186,7 @@ TEST(MultilevelCorrection, IsTheGalerkinFormulaOnEveryLevel) {
     for (unsigned seed = 1; seed <= 3; ++seed) {
       const Eigen::VectorXd v = uniform_random_vector(map.size(), seed);
       const Eigen::VectorXd want = expected * v;
-      EXPECT_LT((apply(c, map, v) - want).norm(), 1e-11 * want.norm()) << profile_name;
+      EXPECT_LT((apply_correction(c, map, v) - want).norm(), 1e-11 * want.norm()) << profile_name;
     }
   }
 }
@@ -240,11 +222,11 @@ TEST(MultilevelCorrection, IsTheGalerkinFormulaAtADeformedState) {
   for (unsigned seed = 1; seed <= 3; ++seed) {
     const Eigen::VectorXd v = uniform_random_vector(map.size(), seed);
     const Eigen::VectorXd want = expected * v;
-    EXPECT_LT((apply(c, map, v) - want).norm(), 1e-11 * want.norm());
+    EXPECT_LT((apply_correction(c, map, v) - want).norm(), 1e-11 * want.norm());
     // The deformation changes it (else the check above could not tell the states apart).
-    const Eigen::VectorXd rest = apply(at_rest, map, v);
+    const Eigen::VectorXd rest = apply_correction(at_rest, map, v);
     EXPECT_GT((rest - want).norm(), 1e-3 * want.norm());
-    EXPECT_LT((apply(at_reference, map, v) - rest).norm(), 1e-12 * rest.norm());
+    EXPECT_LT((apply_correction(at_reference, map, v) - rest).norm(), 1e-12 * rest.norm());
   }
 }
 
@@ -260,10 +242,10 @@ TEST(MultilevelCorrection, IsSymmetricPositiveDefinite) {
                                      kForceScale);
   const Eigen::VectorXd v = uniform_random_vector(map.size(), 11);
   const Eigen::VectorXd w = uniform_random_vector(map.size(), 12);
-  const double vcw = v.dot(apply(c, map, w));
-  EXPECT_NEAR(vcw, w.dot(apply(c, map, v)), 1e-12 * std::abs(vcw));
-  EXPECT_GT(v.dot(apply(c, map, v)), 0.0);
-  EXPECT_GT(w.dot(apply(c, map, w)), 0.0);
+  const double vcw = v.dot(apply_correction(c, map, w));
+  EXPECT_NEAR(vcw, w.dot(apply_correction(c, map, v)), 1e-12 * std::abs(vcw));
+  EXPECT_GT(v.dot(apply_correction(c, map, v)), 0.0);
+  EXPECT_GT(w.dot(apply_correction(c, map, w)), 0.0);
   // It reads the lattice through the map it is given: one with other free coordinates is refused.
   sys.set_constraints(faces_held(l, {lat::Face::bottom}));
   const mess::DofMap other(sys.constraints(), l.positions, l.element_length);
@@ -289,13 +271,13 @@ TEST(MultilevelCorrection, IsBitwiseTheSameOnEveryThreadCount) {
                                      kForceScale);
   EXPECT_GE(c.levels(), 2);
   const Eigen::VectorXd v = uniform_random_vector(map.size(), 5);
-  const Eigen::VectorXd one = apply(c, map, v);
+  const Eigen::VectorXd one = apply_correction(c, map, v);
   for (const int t : {2, 3}) {
     omp_set_num_threads(t);
     const mess::MultilevelCorrection other(l, sys.settings().elastic.volume_force_factor, map,
                                            kForceScale);
-    EXPECT_EQ(apply(other, map, v), one) << t << " threads";
-    EXPECT_EQ(apply(c, map, v), one) << t << " threads";
+    EXPECT_EQ(apply_correction(other, map, v), one) << t << " threads";
+    EXPECT_EQ(apply_correction(c, map, v), one) << t << " threads";
   }
   omp_set_num_threads(threads);
 }
