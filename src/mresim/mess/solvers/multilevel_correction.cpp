@@ -367,10 +367,6 @@ void add_stiffness(const lattice::Lattice& lattice, const Eigen::Matrix3Xd* stat
       });
 }
 
-}  // namespace
-
-namespace {
-
 // The process that builds each level when `processes` share the build: the levels in build
 // order (the coarsest, about twice the work of another, first), each to the process with the
 // least work so far (the lowest rank on a tie). The same on every process.
