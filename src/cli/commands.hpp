@@ -62,10 +62,6 @@ void end_job_on_error(const std::exception& error, const mess::MpiJob& job);
 // Under mpirun with P > 1: throws std::invalid_argument unless the plan splits over processes.
 void refuse_unsplittable_plan(const app::RunPlan& plan, const std::string& run_type);
 
-// Commands that cannot run over MPI processes yet (extend, rerun) call this first:
-// under mpirun with more than one process it throws std::invalid_argument naming `command`.
-void refuse_mpi_job(const char* command);
-
 // A run with --set overrides keeps them and the run file as written in this file of its staging
 // directory while it computes, so that `mresim resume` (whose checkpoint holds only the
 // effective run file) records them in results.h5 too; removed before the results are published.

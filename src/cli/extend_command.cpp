@@ -4,8 +4,10 @@
 // and the planned steps are checked to only lengthen the protocol, before anything is written.
 // The directory is replaced all at once, as by `mresim run`; an interrupted extend leaves the
 // original run as it was and a staging directory that `mresim resume DIR` continues.
+// Under `mpirun -np P` the new steps' relaxations split over the processes, as `mresim run`'s do.
 
 #include <cstdio>
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -34,8 +36,12 @@ CLI::App* add_extend_command(CLI::App& app, ExtendOptions& options) {
 }
 
 int extend_command(const ExtendOptions& options) {
-  refuse_mpi_job("extend");
-  configure_output(options.output, options.dir, true);  // the run's log continues
+  // Under `mpirun -np P` (P > 1, docs/mpi.md) rank 0 does what a single process does; the
+  // others wait for its prepared staging directory and compute the new steps alongside it.
+  const mess::MpiJob job = mess::mpi_job();
+  // The run's log continues.
+  configure_output(job.rank == 0 ? options.output : OutputOptions{true, std::nullopt}, options.dir,
+                   true);
   mess_protocol::check_extend_overrides(options.overrides);
   const auto computed = finished_run_file(options.dir, {}, "extend");
   const auto extended = finished_run_file(options.dir, options.overrides, "extend");
@@ -44,12 +50,22 @@ int extend_command(const ExtendOptions& options) {
   // The plan validates the extended file as `mresim run` would, then checks the steps.
   const auto plan = mess_protocol::make_extend_plan(
       computed, extended, options.dir, new_history_entry("extend", words, options.overrides));
+  const std::string run_type = app::read_run_settings(extended).type;
+  if (job.size > 1) {
+    refuse_unsplittable_plan(*plan, run_type);
+    if (job.rank > 0) return participate_in_run(extended, *plan, options.threads, job, {});
+  }
 
-  io::RunDirectory run_dir(options.dir);
-  std::printf("mresim: extending the run in %s\n", options.dir.c_str());
-  std::fflush(stdout);
-  return execute_and_publish(extended, *plan, app::read_run_settings(extended).type, run_dir,
-                             options.threads, options.no_plot);
+  try {
+    io::RunDirectory run_dir(options.dir);
+    std::printf("mresim: extending the run in %s\n", options.dir.c_str());
+    std::fflush(stdout);
+    return execute_and_publish(extended, *plan, run_type, run_dir, options.threads, options.no_plot,
+                               job);
+  } catch (const std::exception& e) {
+    end_job_on_error(e, job);  // the others may wait for the staging directory
+    throw;
+  }
 }
 
 }  // namespace mresim::cli

@@ -1,8 +1,10 @@
 // `mresim rerun DIR --step K [--set solver.KEY=VALUE ...]`: relaxes one step of a finished 3D
 // run again with other solver settings (mess/restart/rerun_plan.hpp). The new result replaces
 // step K; the original is kept in results.h5's /history. The directory is replaced all at once.
+// Under `mpirun -np P` the relaxations split over the processes, as `mresim run`'s do.
 
 #include <cstdio>
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -34,8 +36,12 @@ CLI::App* add_rerun_command(CLI::App& app, RerunOptions& options) {
 }
 
 int rerun_command(const RerunOptions& options) {
-  refuse_mpi_job("rerun");
-  configure_output(options.output, options.dir, true);  // the run's log continues
+  // Under `mpirun -np P` (P > 1, docs/mpi.md) rank 0 does what a single process does; the
+  // others relax the same steps alongside it, reading the run directory, and write nothing.
+  const mess::MpiJob job = mess::mpi_job();
+  // The run's log continues.
+  configure_output(job.rank == 0 ? options.output : OutputOptions{true, std::nullopt}, options.dir,
+                   true);
   mess_protocol::check_rerun_overrides(options.overrides);
   const auto computed = finished_run_file(options.dir, {}, "rerun");
   const auto rerun = finished_run_file(options.dir, options.overrides, "rerun");
@@ -45,14 +51,24 @@ int rerun_command(const RerunOptions& options) {
   const auto plan = mess_protocol::make_rerun_plan(
       computed, rerun, options.dir, static_cast<std::size_t>(options.step),
       new_history_entry("rerun", words, options.overrides));
+  const std::string run_type = app::read_run_settings(computed).type;
+  if (job.size > 1) {
+    refuse_unsplittable_plan(*plan, run_type);
+    if (job.rank > 0) return participate_in_run(rerun, *plan, options.threads, job, {});
+  }
 
-  io::RunDirectory run_dir(options.dir);
-  std::printf("mresim: relaxing step %ld of the run in %s again\n", options.step,
-              options.dir.c_str());
-  std::fflush(stdout);
-  // The results record the run file the run was made with: the other steps are its results.
-  return execute_and_publish(computed, *plan, app::read_run_settings(computed).type, run_dir,
-                             options.threads, options.no_plot);
+  try {
+    io::RunDirectory run_dir(options.dir);
+    std::printf("mresim: relaxing step %ld of the run in %s again\n", options.step,
+                options.dir.c_str());
+    std::fflush(stdout);
+    // The results record the run file the run was made with: the other steps are its results.
+    return execute_and_publish(computed, *plan, run_type, run_dir, options.threads, options.no_plot,
+                               job);
+  } catch (const std::exception& e) {
+    end_job_on_error(e, job);  // the others may wait in a collective call
+    throw;
+  }
 }
 
 }  // namespace mresim::cli

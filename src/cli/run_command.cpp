@@ -92,14 +92,6 @@ void end_job_on_error(const std::exception& error, const mess::MpiJob& job) {
   mess::abort_job(kFailure);
 }
 
-void refuse_mpi_job(const char* command) {
-  if (mess::mpi_job().size > 1) {
-    throw std::invalid_argument(fmt::format(
-        "mresim {} cannot run over MPI processes yet (docs/mpi.md); run it without mpirun",
-        command));
-  }
-}
-
 namespace {
 
 // Threads per process: the --threads option, else [run].threads; 0 means all cores, which the

@@ -134,10 +134,23 @@ TEST(MpiRunCli, RefusesWhatCannotSplitOverProcesses) {
   EXPECT_NE(r.err.find("solver.method = \"newton\""), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "newton"));
 
-  const Result extend = run(dir.path(), 2, {"extend", "newton", "--set", "field.max=0.03"});
-  EXPECT_NE(extend.status, 0);
-  EXPECT_NE(extend.err.find("mresim extend cannot run over MPI processes"), std::string::npos)
-      << extend.err;
+  // A rerun whose steps before --step must be computed again (their states not kept) with the
+  // run's own method, which cannot split: refused before anything is written.
+  // (0 and 20 mT only: Newton's run is the slow part of this test.)
+  std::vector<std::string> newton_run = run_args("newton_run");
+  newton_run.insert(newton_run.end(),
+                    {"--set", "field.sequence=up", "--set", "solver.method=newton", "--set",
+                     "output.node_positions=false"});
+  ASSERT_EQ(run(dir.path(), 0, newton_run).status, 0);
+  const std::set<std::string> before = files_in(dir / "newton_run");
+  const Result rerun =
+      run(dir.path(), 2,
+          {"rerun", "newton_run", "--step", "1", "--no-plot", "--set", "solver.method=minimiser"});
+  EXPECT_EQ(rerun.status, 2) << rerun.err;
+  EXPECT_NE(rerun.err.find("--step 1: the state before it was not kept"), std::string::npos)
+      << rerun.err;
+  EXPECT_NE(rerun.err.find("solver.method = \"newton\""), std::string::npos) << rerun.err;
+  EXPECT_EQ(files_in(dir / "newton_run"), before);
 
   const std::string pair =
       std::string(MRESIM_SOURCE_DIR) + "/examples/fig2_2_single_spring_axial.toml";
@@ -146,6 +159,93 @@ TEST(MpiRunCli, RefusesWhatCannotSplitOverProcesses) {
   EXPECT_NE(two_dipole.err.find("cannot split a run over MPI processes"), std::string::npos)
       << two_dipole.err;
   EXPECT_FALSE(fs::exists(dir / "pair"));
+}
+
+// Every result `mresim extend` and `rerun` write per step, between a single-process and a
+// two-process command: the relaxations' states bitwise (the split evaluation's gradient is the
+// single process's), the energies to rounding (their node sums are added per process).
+void expect_same_steps(const fs::path& one, const fs::path& two) {
+  const Hdf5Reader a(one / "results.h5");
+  const Hdf5Reader b(two / "results.h5");
+  EXPECT_EQ(b.scalar_attribute<std::int64_t>("/", "mpi_processes", H5T_NATIVE_INT64), 2);
+  for (const char* path : {"/steps/centres", "/steps/magnetization", "/steps/solver/max_force"}) {
+    EXPECT_EQ(a.doubles(path), b.doubles(path)) << path;
+  }
+  EXPECT_EQ(a.ints("/steps/solver/iterations"), b.ints("/steps/solver/iterations"));
+  EXPECT_EQ(a.ints("/steps/valid"), b.ints("/steps/valid"));
+  const std::vector<double> ea = a.doubles("/steps/energies/total");
+  const std::vector<double> eb = b.doubles("/steps/energies/total");
+  ASSERT_EQ(ea.size(), eb.size());
+  for (std::size_t i = 0; i < ea.size(); ++i) {
+    EXPECT_LE(std::abs(ea[i] - eb[i]), 1e-12 * std::abs(ea[i])) << "step " << i;
+  }
+  // The history entry that records the command, the same in both.
+  EXPECT_EQ(a.ints("/history/0/replaced_steps"), b.ints("/history/0/replaced_steps"));
+  EXPECT_EQ(files_in(one), files_in(two));
+}
+
+// `mpirun -np 2 mresim extend` and `rerun` (docs/mpi.md): the same steps as one process.
+TEST(MpiRunCli, ExtendAndRerunOverProcessesGiveTheResultsOfOne) {
+  if (!have_mpirun()) GTEST_SKIP() << "no MPI launcher (mpirun) found";
+  const TempDir dir;
+  ASSERT_EQ(run(dir.path(), 0, run_args("base")).status, 0);
+  for (const char* copy : {"extend_one", "extend_two", "rerun_one", "rerun_two"}) {
+    fs::copy(dir / "base", dir / copy, fs::copy_options::recursive);
+  }
+  // The loop to 40 mT in 20 mT steps: five steps added to the six computed.
+  const std::vector<std::string> extend = {
+      "--no-plot", "-j", "1", "--set", "field.max=0.04", "--set", "field.steps=2"};
+  std::vector<std::string> extend_one = {"extend", "extend_one"};
+  extend_one.insert(extend_one.end(), extend.begin(), extend.end());
+  std::vector<std::string> extend_two = {"extend", "extend_two"};
+  extend_two.insert(extend_two.end(), extend.begin(), extend.end());
+  const Result e1 = run(dir.path(), 0, extend_one);
+  ASSERT_EQ(e1.status, 0) << e1.err;
+  const Result e2 = run(dir.path(), 2, extend_two);
+  ASSERT_EQ(e2.status, 0) << e2.err;
+  EXPECT_EQ(Hdf5Reader(dir / "extend_two" / "results.h5").doubles("/steps/centres").size(),
+            11U * 2U * 3U);
+  expect_same_steps(dir / "extend_one", dir / "extend_two");
+
+  // Step 2 (0 mT after 20 mT) relaxed again with a 100 times tighter force tolerance.
+  const std::vector<std::string> rerun = {
+      "--step", "2", "--no-plot", "-j", "1", "--set", "solver.minimiser.force_tolerance=1e-8"};
+  std::vector<std::string> rerun_one = {"rerun", "rerun_one"};
+  rerun_one.insert(rerun_one.end(), rerun.begin(), rerun.end());
+  std::vector<std::string> rerun_two = {"rerun", "rerun_two"};
+  rerun_two.insert(rerun_two.end(), rerun.begin(), rerun.end());
+  const Result r1 = run(dir.path(), 0, rerun_one);
+  ASSERT_EQ(r1.status, 0) << r1.err;
+  const Result r2 = run(dir.path(), 2, rerun_two);
+  ASSERT_EQ(r2.status, 0) << r2.err;
+  expect_same_steps(dir / "rerun_one", dir / "rerun_two");
+  // The rerun did relax step 2 again (tighter: a smaller largest force than the run's).
+  EXPECT_LT(Hdf5Reader(dir / "rerun_two" / "results.h5").doubles("/steps/solver/max_force")[2],
+            Hdf5Reader(dir / "base" / "results.h5").doubles("/steps/solver/max_force")[2]);
+}
+
+// A rerun of a run that kept no positions computes the steps before --step again first; over
+// two processes both relaxations split, to the single process's results.
+TEST(MpiRunCli, RerunThatComputesEarlierStepsAgainSplitsThemToo) {
+  if (!have_mpirun()) GTEST_SKIP() << "no MPI launcher (mpirun) found";
+  const TempDir dir;
+  std::vector<std::string> args = run_args("base");
+  args.insert(args.end(), {"--set", "output.node_positions=false"});
+  ASSERT_EQ(run(dir.path(), 0, args).status, 0);
+  fs::copy(dir / "base", dir / "one", fs::copy_options::recursive);
+  fs::copy(dir / "base", dir / "two", fs::copy_options::recursive);
+  const std::vector<std::string> rerun = {
+      "--step", "3", "--no-plot", "-j", "1", "--set", "solver.minimiser.force_tolerance=1e-8"};
+  std::vector<std::string> one = {"rerun", "one"};
+  one.insert(one.end(), rerun.begin(), rerun.end());
+  std::vector<std::string> two = {"rerun", "two"};
+  two.insert(two.end(), rerun.begin(), rerun.end());
+  const Result r1 = run(dir.path(), 0, one);
+  ASSERT_EQ(r1.status, 0) << r1.err;
+  const Result r2 = run(dir.path(), 2, two);
+  ASSERT_EQ(r2.status, 0) << r2.err;
+  EXPECT_NE(r2.err.find("steps 0 to 2 are computed again first"), std::string::npos) << r2.err;
+  expect_same_steps(dir / "one", dir / "two");
 }
 
 // The processes of mpirun, i.e. its children (the launcher starts them directly on this

@@ -8,6 +8,7 @@
 
 #include "mresim/io/hdf5_reader.hpp"
 #include "mresim/io/run_directory.hpp"
+#include "mresim/mess/distributed/mpi_job.hpp"
 #include "mresim/mess/outputs/checkpoint.hpp"
 #include "mresim/mess/outputs/mess_outputs.hpp"
 #include "mresim/mess/protocols/step_plan.hpp"
@@ -43,7 +44,21 @@ class ExtendPlan final : public app::RunPlan {
   void execute(const fs::path& staging_dir, io::Hdf5File& results,
                app::Progress& progress) const override {
     prepare(staging_dir);
+    // Under `mpirun -np P` (P > 1) the other processes wait in participate() for the prepared
+    // staging directory, then continue from its checkpoint with this process, as `mresim
+    // resume` does (the processes share the file system).
+    if (mess::mpi_job().size > 1) (void)mess::broadcast_text(staging_dir.string());
     inner_->execute(staging_dir, results, progress);
+  }
+
+  // The run type's own plan splits (it refused at construction what cannot).
+  [[nodiscard]] bool splits_over_processes() const override {
+    return inner_->splits_over_processes();
+  }
+
+  // The other processes: the extended run from the staging directory that execute() prepared.
+  void participate(const fs::path& /*staging_dir*/) const override {
+    inner_->participate(mess::broadcast_text({}));
   }
 
  private:

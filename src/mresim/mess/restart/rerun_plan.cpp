@@ -11,11 +11,13 @@
 #include "mresim/config/config_error.hpp"
 #include "mresim/io/hdf5_reader.hpp"
 #include "mresim/io/run_directory.hpp"
+#include "mresim/mess/distributed/mpi_job.hpp"
 #include "mresim/mess/outputs/checkpoint.hpp"
 #include "mresim/mess/outputs/mess_outputs.hpp"
 #include "mresim/mess/protocols/step_plan.hpp"
 #include "mresim/mess/restart/saved_run.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
+#include "mresim/mess/runs/process_split.hpp"
 #include "mresim/mess/solvers/amg_preconditioner.hpp"
 #include "mresim/pair/runs/pair_outputs.hpp"
 
@@ -68,7 +70,13 @@ class RerunPlan final : public app::RunPlan {
         computed_spec_.solver.method == mc::SolverMethod::newton) {
       mess::initialise_petsc();
     }
+    // Under `mpirun -np P` (P > 1) both relaxations split over the processes: the rerun's
+    // (make_plan above refused what it cannot split) and, where the state before step K was not
+    // kept, the run's own for the steps before it.
+    if (mess::mpi_job().size > 1) refuse_recomputation_that_cannot_split();
   }
+
+  [[nodiscard]] bool splits_over_processes() const override { return true; }
 
   void describe(app::InfoReport& report) const override { mc::describe_mess(rerun_spec_, report); }
 
@@ -85,23 +93,8 @@ class RerunPlan final : public app::RunPlan {
       const io::Hdf5Reader old_results(run_dir_ / io::RunDirectory::kMarkerFile);
       history = read_history(old_results, computed);
     }
-    const std::size_t start = last_restorable(saved, computed, step_);
-    progress.set_total(step_ - start + 1);
-    ProtocolState state = *state_after(saved, computed, start);
-    if (start < step_) {
-      std::cerr << fmt::format(
-          "mresim: the state before step {} was not kept ([output] node_positions = false); "
-          "steps {} to {} are computed again first with the run's settings\n",
-          step_, start, step_ - 1);
-      ProtocolRunner again(computed_spec_);
-      while (state.next_step < step_) {
-        again.run_next_step(state);
-        progress.advance();
-      }
-    }
     ProtocolRunner rerunner(rerun_spec_);
-    const StepRecord record = rerunner.run_next_step(state);
-    progress.advance();
+    const StepRecord record = relax_step(saved, computed, rerunner, &progress);
     print_comparison(step_, saved.records[step_], record);
 
     HistoryEntry entry = entry_;
@@ -139,7 +132,63 @@ class RerunPlan final : public app::RunPlan {
     if (!invalid.empty()) throw app::InvalidResults(invalid);
   }
 
+  // The other processes of `mpirun -np P`: execute()'s relaxations, collectively with it,
+  // writing nothing (the saved run is read from the run directory, which the processes share).
+  void participate(const fs::path& /*staging_dir*/) const override {
+    ProtocolRunner computed(computed_spec_);
+    computed.set_scratch_directory(fs::temp_directory_path());  // as MessPlan::participate
+    SavedRun saved = read_saved_run(run_dir_, computed, computed_toml_);
+    ProtocolRunner rerunner(rerun_spec_);
+    (void)relax_step(saved, computed, rerunner, nullptr);
+  }
+
  private:
+  // Relaxes step K again into `rerunner`, from the state before it: restored from `saved`, or,
+  // where it was not kept, computed again from the latest kept one with the run's own
+  // settings. `progress`: rank 0's (or a single process's), null on the other processes.
+  StepRecord relax_step(const SavedRun& saved, const ProtocolRunner& computed,
+                        ProtocolRunner& rerunner, app::Progress* progress) const {
+    const std::size_t start = last_restorable(saved, computed, step_);
+    if (progress != nullptr) progress->set_total(step_ - start + 1);
+    ProtocolState state = *state_after(saved, computed, start);
+    if (start < step_) {
+      if (progress != nullptr) {
+        std::cerr << fmt::format(
+            "mresim: the state before step {} was not kept ([output] node_positions = false); "
+            "steps {} to {} are computed again first with the run's settings\n",
+            step_, start, step_ - 1);
+      }
+      ProtocolRunner again(computed_spec_);
+      (void)split_over_processes(again);
+      while (state.next_step < step_) {
+        again.run_next_step(state);
+        if (progress != nullptr) progress->advance();
+      }
+    }
+    (void)split_over_processes(rerunner);
+    StepRecord record = rerunner.run_next_step(state);
+    if (progress != nullptr) progress->advance();
+    return record;
+  }
+
+  // Under mpirun: the steps before K are computed again only where a state before K was not
+  // kept; refuse that (before anything is written) when the run's own solver cannot split. The
+  // energy terms are the rerun's, which make_plan checked. Every step's positions before K kept
+  // is enough for the state before K (saved_run.hpp).
+  void refuse_recomputation_that_cannot_split() const {
+    const mc::SolverMethod method = computed_spec_.solver.method;
+    if (method_splits_over_processes(method)) return;
+    for (std::size_t k = 0; k < step_; ++k) {
+      if (!fs::exists(step_positions_file(run_dir_, k))) {
+        throw config::ConfigError(fmt::format(
+            "--step {}: the state before it was not kept ([output] node_positions = false), so "
+            "steps before it would be computed again with the run's solver.method = \"{}\", "
+            "which cannot split over MPI processes (docs/mpi.md); run this rerun without mpirun",
+            step_, mc::solver_method_name(method)));
+      }
+    }
+  }
+
   mc::MessSpec computed_spec_;
   mc::MessSpec rerun_spec_;
   std::string computed_toml_;

@@ -238,10 +238,7 @@ void describe_solver(const MessSpec& s, app::InfoReport& r) {
   const SolverSpec& v = s.solver;
   const std::string sec = "solver";
   if (v.method != SolverMethod::leapfrog) {
-    r.add_text(sec, "method",
-               v.method == SolverMethod::newton  ? "newton"
-               : v.method == SolverMethod::lbfgs ? "lbfgs"
-                                                 : "minimiser",
+    r.add_text(sec, "method", solver_method_name(v.method),
                v.method == SolverMethod::newton ? "Newton-Krylov with algebraic multigrid"
                : v.method == SolverMethod::lbfgs
                    ? "L-BFGS, rigid-particle preconditioner"

@@ -130,6 +130,21 @@ struct StressSpec {
 // against); newton: Newton-Krylov; leapfrog: the original's damped leapfrog.
 enum class SolverMethod { minimiser, lbfgs, newton, leapfrog };
 
+// The run file's spelling of `method` ("minimiser", "lbfgs", "newton", "leapfrog").
+constexpr const char* solver_method_name(SolverMethod method) {
+  switch (method) {
+    case SolverMethod::lbfgs:
+      return "lbfgs";
+    case SolverMethod::newton:
+      return "newton";
+    case SolverMethod::leapfrog:
+      return "leapfrog";
+    case SolverMethod::minimiser:
+      break;
+  }
+  return "minimiser";
+}
+
 struct MinimiserSettings {
   // Converged when the largest net force on a free node is below force_tolerance * k_eff l_e
   // (the characteristic force of the seed's scaling,

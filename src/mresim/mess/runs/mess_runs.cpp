@@ -19,9 +19,6 @@
 #include "mresim/app/run_output.hpp"
 #include "mresim/app/run_type.hpp"
 #include "mresim/app/stop_signal.hpp"
-#include "mresim/config/config_error.hpp"
-#include "mresim/mess/distributed/distributed_evaluator.hpp"
-#include "mresim/mess/distributed/distributed_system.hpp"
 #include "mresim/mess/distributed/mpi_job.hpp"
 #include "mresim/mess/outputs/checkpoint.hpp"
 #include "mresim/mess/outputs/mess_outputs.hpp"
@@ -30,6 +27,7 @@
 #include "mresim/mess/restart/run_history.hpp"
 #include "mresim/mess/restart/saved_run.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
+#include "mresim/mess/runs/process_split.hpp"
 #include "mresim/mess/solvers/amg_preconditioner.hpp"
 #include "mresim/mess/solvers/relaxation_observer.hpp"
 #include "mresim/pair/runs/pair_outputs.hpp"
@@ -53,7 +51,7 @@ class MessPlan final : public app::RunPlan {
     if (spec_.solver.method == mc::SolverMethod::newton) mess::initialise_petsc();
     // Under `mpirun -np P` (P > 1) every relaxation's evaluations are split over the
     // processes (docs/mpi.md): refuse now, on every process, what cannot be split yet.
-    if (mess::mpi_job().size > 1) refuse_what_cannot_split();
+    refuse_what_cannot_split(spec_);
   }
 
   [[nodiscard]] bool splits_over_processes() const override { return true; }
@@ -158,35 +156,6 @@ class MessPlan final : public app::RunPlan {
   }
 
  private:
-  // Under `mpirun -np P` with P > 1: the runner's relaxations split their evaluations over
-  // all processes. Returns whether it does.
-  static bool split_over_processes(ProtocolRunner& runner) {
-    if (mess::mpi_job().size == 1) return false;
-    runner.set_distributed(std::make_shared<mess::DistributedEvaluator>(MPI_COMM_WORLD));
-    return true;
-  }
-
-  // What splitting over processes does not support yet, as run-file errors naming the key.
-  void refuse_what_cannot_split() const {
-    const char* method = spec_.solver.method == mc::SolverMethod::newton ? "newton" : "leapfrog";
-    if (spec_.solver.method != mc::SolverMethod::minimiser &&
-        spec_.solver.method != mc::SolverMethod::lbfgs) {
-      throw config::ConfigError(fmt::format(
-          "solver.method = \"{}\": under mpirun with more than one process only \"minimiser\" "
-          "and \"lbfgs\" split a relaxation over the processes (docs/mpi.md); run this file "
-          "without mpirun",
-          method));
-    }
-    for (const mess::TermSpec& term : spec_.terms) {
-      if (!mess::DistributedSystem::supports(term.name)) {
-        throw config::ConfigError(
-            fmt::format("[terms.{}]: this energy term cannot be evaluated over MPI processes yet "
-                        "(docs/mpi.md); run this file without mpirun",
-                        term.name));
-      }
-    }
-  }
-
   // The process's peak resident memory so far (the relaxations are done), in results.h5 and
   // in the log, absolute and per lattice node.
   static void write_peak_memory(io::Hdf5File& results, std::int64_t nodes,
@@ -210,10 +179,7 @@ class MessPlan final : public app::RunPlan {
                  ? fmt::format("{:.1f} GiB", static_cast<double>(bytes) / (1 << 30))
                  : fmt::format("{:.1f} MiB", static_cast<double>(bytes) / (1 << 20));
     };
-    const char* method = spec_.solver.method == mc::SolverMethod::newton     ? "newton"
-                         : spec_.solver.method == mc::SolverMethod::leapfrog ? "leapfrog"
-                         : spec_.solver.method == mc::SolverMethod::lbfgs    ? "lbfgs"
-                                                                             : "minimiser";
+    const char* method = mc::solver_method_name(spec_.solver.method);
     std::string line = fmt::format(
         "mresim: lattice {} x {} x {} nodes ({} nodes, {} particles), {} steps, solver {}, "
         "memory estimate {}",
