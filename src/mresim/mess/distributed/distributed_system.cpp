@@ -13,15 +13,18 @@ namespace {
 namespace mm = mresim::magnetism;
 
 // The terms evaluated here: the elastic ones on each process's nodes, the load as a sum over
-// them, and the terms of the particle centres and magnetizations only, on every process.
-constexpr std::array<std::string_view, 8> kSupportedTerms = {
-    "springs", "volume", "zeeman", "dipole", "self", "self_linearized", "wca", "load"};
+// them, and the terms of the particle centres and magnetizations only, on every process
+// (field_gradient, eq. 4.77's Kelvin force, is one of those: terms/field_gradient_term.cpp).
+constexpr std::array<std::string_view, 9> kSupportedTerms = {"springs", "volume", "zeeman",
+                                                             "dipole",  "self",   "self_linearized",
+                                                             "wca",     "load",   "field_gradient"};
 
 void check_supported(std::string_view name) {
   if (DistributedSystem::supports(name)) return;
   throw std::invalid_argument("DistributedSystem: the energy term '" + std::string(name) +
                               "' cannot be evaluated over processes yet (supported: springs, "
-                              "volume, zeeman, dipole, self, self_linearized, wca, load)");
+                              "volume, zeeman, dipole, self, self_linearized, wca, load, "
+                              "field_gradient)");
 }
 
 void check_mpi(int code, const char* what) {

@@ -44,8 +44,11 @@ class DistributedSystem {
   // of the potential at the owned nodes (J/m; held coordinates not zeroed).
   Evaluation evaluate(Vec positions, Vec gradient);
 
-  // Whether a term of this name can be evaluated here (the built-in terms; not yet the
-  // optional ones of [terms.<name>] tables).
+  // Whether a term of this name can be evaluated here: the elastic terms and the load over the
+  // processes' nodes, and the terms that read only the particle centres and magnetizations
+  // (the magnetic ones, WCA, the optional field_gradient) on every process. A new term must be
+  // added to the list once its distributed form is decided (a term that reads node positions
+  // needs its own sum over the owned nodes, as the load has).
   [[nodiscard]] static bool supports(std::string_view term);
 
   // The particle centres at the last evaluate() (3 x N_p, m), the same on every process.

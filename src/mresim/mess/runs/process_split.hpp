@@ -19,7 +19,8 @@ bool method_splits_over_processes(mess_config::SolverMethod method);
 
 // Under `mpirun -np P` with P > 1: throws config::ConfigError, naming the key, for what a
 // relaxation of `spec` cannot split over the processes yet (a solver method other than
-// "minimiser" and "lbfgs", an optional energy term). Does nothing on one process.
+// "minimiser" and "lbfgs", an energy term without a distributed form). Does nothing on one
+// process.
 void refuse_what_cannot_split(const mess_config::MessSpec& spec);
 
 }  // namespace mresim::mess_protocol
