@@ -237,18 +237,23 @@ TEST(VolumeKernel, GradientMatchesTheReferenceOnSmallBoxes) {
 }
 
 TEST(VolumeKernel, GradientMatchesTheReferenceOnEveryThreadCount) {
-  // Layers of 256 cells (many per energy block), and layers of 4,200 cells (more than a block:
-  // a thread's blocks can lie inside one layer, and with 8 threads some own no plane at all).
+  // The kernel splits the node planes of constant y over the threads, and each cell's energy
+  // comes from the thread of its layer. Layers of 384 cells (many layers per energy block, which
+  // runs along x and y), of 350 cells over 61 planes, and of 9,600 cells over 3 planes (with 3
+  // and 8 threads some threads own no plane, or only the top one, which starts no layer).
   const mess::ModelProfile seed = mess::model_profile("seed");
   const lat::Lattice thin_layers = small_lattice(seed, {16, 16, 24}, {{8, 8, 6}, {8, 8, 16}});
   const lat::Lattice wide_layers = small_lattice(seed, {70, 60, 5});
+  const lat::Lattice few_planes = small_lattice(seed, {160, 2, 60});
   ASSERT_GE(static_cast<std::int64_t>(wide_layers.elements.size()), mess::detail::kParallelMinimum);
+  ASSERT_GE(static_cast<std::int64_t>(few_planes.elements.size()), mess::detail::kParallelMinimum);
   const int saved = omp_get_max_threads();
   for (const int threads : {1, 2, 3, 8}) {
     SCOPED_TRACE(threads);
     omp_set_num_threads(threads);
     expect_volume_kernel_matches_reference(thin_layers, 4.0);
     expect_volume_kernel_matches_reference(wide_layers, 1.0);
+    expect_volume_kernel_matches_reference(few_planes, 1.0);
   }
   omp_set_num_threads(saved);
 }

@@ -556,118 +556,123 @@ ElasticValue VolumeKernel::evaluate(const lattice::Lattice& lat, const Eigen::Ma
 
 namespace {
 
-// One thread's scratch for the cell layers (VolumeKernel::evaluate_with_gradient): two node
-// planes of positions, x fastest (plane iz in slot iz mod 2, three component arrays each), two
-// layers of cell coefficients (layer cz in slot cz mod 2, nine arrays over the layer's cells),
-// one cell row's energies and roundings and one node row's gradients; and the three steps.
+// One thread's scratch for the cell layers along y (VolumeKernel::evaluate_with_gradient): two
+// node planes of positions (plane iy in slot iy mod 2; a plane of constant y is nx z-lines, z
+// fastest, one contiguous run of the node numbering, copied into three component arrays), two
+// layers of cell coefficients (layer cy in slot cy mod 2, nine arrays over the layer's cells,
+// cz fastest), the layer's energies and roundings, and one node line's gradients.
 class CellLayers {
  public:
   CellLayers(const lattice::GridShape& shape, double* scratch)
       : nx_(shape.nx()),
         ny_(shape.ny()),
         nz_(shape.nz()),
-        row_cells_(nx_ - 1),
-        layer_(row_cells_ * (ny_ - 1)),
-        plane_(nx_ * ny_),
+        line_cells_(nz_ - 1),
+        layer_((nx_ - 1) * line_cells_),
+        plane_(nx_ * nz_),
         planes_(scratch),
         coefficients_(planes_ + 6 * plane_),   // two planes of three components
         energy_(coefficients_ + 18 * layer_),  // two layers of nine coefficients
-        rounding_(energy_ + row_cells_),
-        gx_(rounding_ + row_cells_),
-        gy_(gx_ + nx_),
-        gz_(gy_ + nx_) {}
+        rounding_(energy_ + layer_),
+        gx_(rounding_ + layer_),
+        gy_(gx_ + nz_),
+        gz_(gy_ + nz_) {}
 
   // Doubles of scratch one thread needs.
   static std::int64_t scratch_size(const lattice::GridShape& shape) {
-    const std::int64_t row_cells = shape.nx() - 1;
-    const std::int64_t layer = row_cells * (shape.ny() - 1);
-    // Two planes of three components, two layers of nine coefficients, a row's energies and
-    // roundings, a row's gradients.
-    return 6 * (std::int64_t{shape.nx()} * shape.ny()) + 18 * layer + 2 * row_cells +
-           3 * std::int64_t{shape.nx()};
+    const std::int64_t plane = std::int64_t{shape.nx()} * shape.nz();
+    const std::int64_t layer = std::int64_t{shape.nx() - 1} * (shape.nz() - 1);
+    // Two planes of three components, two layers of nine coefficients, a layer's energies and
+    // roundings, a node line's gradients.
+    return 6 * plane + 20 * layer + 3 * std::int64_t{shape.nz()};
   }
 
-  // Copies node plane iz of x into its slot.
-  void load_plane(const Eigen::Matrix3Xd& x, std::int64_t iz) {
-    double* p = plane_of(iz);
-    for (std::int64_t iy = 0; iy < ny_; ++iy) {
-      for (std::int64_t ix = 0; ix < nx_; ++ix, ++p) {
-        const std::int64_t n = node_of(ix, iy, iz);
-        p[0] = x(0, n);
-        p[plane_] = x(1, n);
-        p[2 * plane_] = x(2, n);
-      }
+  // Copies node plane iy of x into its slot.
+  void load_plane(const Eigen::Matrix3Xd& x, std::int64_t iy) {
+    double* const p = plane_of(iy);
+    const double* const source = x.data() + 3 * plane_ * iy;
+    for (std::int64_t k = 0; k < plane_; ++k) {
+      p[k] = source[3 * k];
+      p[plane_ + k] = source[3 * k + 1];
+      p[2 * plane_ + k] = source[3 * k + 2];
     }
   }
 
-  // The coefficients of layer cz (planes cz and cz + 1 loaded) and its cells' energies.
-  void compute_layer(std::int64_t cz, double kappa, double v0, double force_factor,
-                     OwnBlockSums& sums) {
-    for (std::int64_t cy = 0; cy < ny_ - 1; ++cy) {
+  // The coefficients of layer cy (planes cy and cy + 1 loaded), one z-line of cells at a time;
+  // with `cells` (energy and rounding per cell, in cell index order) the cells' energies too.
+  void compute_layer(std::int64_t cy, double kappa, double v0, double force_factor,
+                     std::array<double, 2>* cells) {
+    for (std::int64_t cx = 0; cx < nx_ - 1; ++cx) {
       cell_rows::Corners corners{};
       for (std::size_t v = 0; v < 8; ++v) {  // local vertex v = 2 dx + 4 dy + dz
         const auto dx = static_cast<std::int64_t>((v >> 1U) & 1U);
         const auto dy = static_cast<std::int64_t>((v >> 2U) & 1U);
         const auto dz = static_cast<std::int64_t>(v & 1U);
-        const double* p = plane_of(cz + dz) + nx_ * (cy + dy) + dx;
+        const double* p = plane_of(cy + dy) + nz_ * (cx + dx) + dz;
         corners.x[v] = p;
         corners.y[v] = p + plane_;
         corners.z[v] = p + 2 * plane_;
       }
+      const std::int64_t line = line_cells_ * cx;
       cell_rows::Coefficients<double*> t{};
-      double* const row = layer_of(cz) + row_cells_ * cy;
-      for (std::size_t k = 0; k < 9; ++k) t[k] = row + static_cast<std::int64_t>(k) * layer_;
-      cell_rows::coefficients(row_cells_, corners, kappa, v0, force_factor, t, energy_, rounding_);
-      const std::int64_t first_cell = cz * layer_ + row_cells_ * cy;
-      for (std::int64_t i = 0; i < row_cells_; ++i) {
-        sums.add(first_cell + i, energy_[i], rounding_[i]);
+      for (std::size_t k = 0; k < 9; ++k) {
+        t[k] = layer_of(cy) + line + static_cast<std::int64_t>(k) * layer_;
+      }
+      cell_rows::coefficients(line_cells_, corners, kappa, v0, force_factor, t, energy_ + line,
+                              rounding_ + line);
+    }
+    if (cells == nullptr) return;
+    // Cell (cx, cy, cz) is cx + Cx (cy + Cy cz): each cz's row of the layer is contiguous there.
+    const std::int64_t cells_x = nx_ - 1;
+    const std::int64_t cells_y = ny_ - 1;
+    for (std::int64_t cz = 0; cz < line_cells_; ++cz) {
+      std::array<double, 2>* const row = cells + cells_x * (cy + cells_y * cz);
+      for (std::int64_t cx = 0; cx < cells_x; ++cx) {
+        row[cx] = {energy_[line_cells_ * cx + cz], rounding_[line_cells_ * cx + cz]};
       }
     }
   }
 
-  // Node plane iz adds its cells' contributions (layers iz - 1 and iz, those in the grid), each
-  // node row one vertex offset at a time in CellStencil's order.
-  void gather_plane(std::int64_t iz, Eigen::Matrix3Xd& gradient) {
-    const std::int64_t layers = nz_ - 1;
-    for (std::int64_t iy = 0; iy < ny_; ++iy) {
-      const std::int64_t first = node_of(0, iy, iz);
-      for (std::int64_t ix = 0; ix < nx_; ++ix) {
-        gx_[ix] = gradient(0, first + nz_ * ix);
-        gy_[ix] = gradient(1, first + nz_ * ix);
-        gz_[ix] = gradient(2, first + nz_ * ix);
+  // Node plane iy adds its cells' contributions (layers iy - 1 and iy, those in the grid), each
+  // node z-line one vertex offset at a time in CellStencil's order.
+  void gather_plane(std::int64_t iy, Eigen::Matrix3Xd& gradient) {
+    const std::int64_t layers = ny_ - 1;
+    for (std::int64_t ix = 0; ix < nx_; ++ix) {
+      double* const g = gradient.data() + 3 * (plane_ * iy + nz_ * ix);
+      for (std::int64_t iz = 0; iz < nz_; ++iz) {
+        gx_[iz] = g[3 * iz];
+        gy_[iz] = g[3 * iz + 1];
+        gz_[iz] = g[3 * iz + 2];
       }
       for (const auto& [dx, dy, dz] : kCellsOfNode) {  // cell (ix - dx, iy - dy, iz - dz)
+        const std::int64_t cx = ix - dx;
         const std::int64_t cy = iy - dy;
-        const std::int64_t cz = iz - dz;
-        if (cy < 0 || cy >= ny_ - 1 || cz < 0 || cz >= layers) continue;
-        const double* const row = layer_of(cz) + row_cells_ * cy;
+        if (cx < 0 || cx >= nx_ - 1 || cy < 0 || cy >= layers) continue;
+        const double* const line = layer_of(cy) + line_cells_ * cx;
         cell_rows::Coefficients<const double*> t{};
-        for (std::size_t k = 0; k < 9; ++k) t[k] = row + static_cast<std::int64_t>(k) * layer_;
+        for (std::size_t k = 0; k < 9; ++k) t[k] = line + static_cast<std::int64_t>(k) * layer_;
         // The node is local vertex 2 dx + 4 dy + dz: signs s_a, s_b, s_c by dx, dy, dz.
-        cell_rows::add_vertex_gradient(row_cells_, t, dx == 1 ? 1.0 : -1.0, dy == 1 ? 1.0 : -1.0,
-                                       dz == 1 ? 1.0 : -1.0, gx_ + dx, gy_ + dx, gz_ + dx);
+        cell_rows::add_vertex_gradient(line_cells_, t, dx == 1 ? 1.0 : -1.0, dy == 1 ? 1.0 : -1.0,
+                                       dz == 1 ? 1.0 : -1.0, gx_ + dz, gy_ + dz, gz_ + dz);
       }
-      for (std::int64_t ix = 0; ix < nx_; ++ix) {
-        gradient(0, first + nz_ * ix) = gx_[ix];
-        gradient(1, first + nz_ * ix) = gy_[ix];
-        gradient(2, first + nz_ * ix) = gz_[ix];
+      for (std::int64_t iz = 0; iz < nz_; ++iz) {
+        g[3 * iz] = gx_[iz];
+        g[3 * iz + 1] = gy_[iz];
+        g[3 * iz + 2] = gz_[iz];
       }
     }
   }
 
  private:
-  std::int64_t node_of(std::int64_t ix, std::int64_t iy, std::int64_t iz) const {
-    return iz + nz_ * (ix + nx_ * iy);
-  }
-  double* plane_of(std::int64_t iz) const { return planes_ + (iz & 1) * 3 * plane_; }
-  double* layer_of(std::int64_t cz) const { return coefficients_ + (cz & 1) * 9 * layer_; }
+  double* plane_of(std::int64_t iy) const { return planes_ + (iy & 1) * 3 * plane_; }
+  double* layer_of(std::int64_t cy) const { return coefficients_ + (cy & 1) * 9 * layer_; }
 
   std::int64_t nx_;
   std::int64_t ny_;
   std::int64_t nz_;
-  std::int64_t row_cells_;  // cells along x
-  std::int64_t layer_;      // cells per layer
-  std::int64_t plane_;      // nodes per plane
+  std::int64_t line_cells_;  // cells along z
+  std::int64_t layer_;       // cells per layer
+  std::int64_t plane_;       // nodes per plane
   double* planes_;
   double* coefficients_;
   double* energy_;
@@ -683,14 +688,15 @@ class CellLayers {
 // and gathered by its eight vertices in CellStencil::gather's order, and the energy is summed
 // in the blocks of detail::fixed_order_sums: bitwise the results of a pass over all cells into
 // a scratch array (9 doubles per cell) and a gather, for any thread count, without that array.
-// Cells are numbered layer by layer along z (cx + Cx (cy + Cy cz)), and the nodes of plane iz
-// hold cells of layers iz - 1 and iz only. So each thread takes a contiguous run of the energy
-// blocks, computes whole layers in order into two layer buffers (layer cz in buffer cz mod 2),
-// and gathers plane iz once layer iz is done. It owns the planes whose first cell lies in its
-// blocks (the last thread also the top plane, which starts no layer); it first computes the
-// layer below its first plane, and its last layer may reach into the next thread's blocks; the
-// energy counts only its own blocks. The work runs along x, one SIMD lane per cell or node
-// (cell_rows.hpp, CellLayers).
+// The work runs in layers of constant y, the slowest axis of the node numbering, so that a
+// node plane and its gradients are contiguous runs of memory, and along z-lines, one SIMD lane
+// per cell or node (cell_rows.hpp, CellLayers); the nodes of plane iy hold cells of layers
+// iy - 1 and iy only. Each thread takes a contiguous run of the node planes, computes the
+// layers they need in order into two layer buffers (layer cy in buffer cy mod 2), the layer
+// below its first plane too (which the thread before also computes), and gathers plane iy once
+// layer iy is done. Cells are numbered layer by layer along z (cx + Cx (cy + Cy cz)), across
+// the y-layers, so each cell's energy and rounding go into an array in cell order (from the
+// thread that owns its layer), summed in the blocks afterwards.
 ElasticValue VolumeKernel::evaluate_with_gradient(const lattice::Lattice& lat,
                                                   const Eigen::Matrix3Xd& x, double force_factor,
                                                   Eigen::Matrix3Xd& gradient) const {
@@ -698,40 +704,38 @@ ElasticValue VolumeKernel::evaluate_with_gradient(const lattice::Lattice& lat,
   if (cells == 0) return {0.0, 0.0};
   const double kappa = lat.polymer.kappa;
   const double v0 = std::pow(lat.element_length, 3);
-  const std::int64_t nz = lat.shape.nz();
-  const std::int64_t layer = std::int64_t{lat.shape.nx() - 1} * (lat.shape.ny() - 1);
-  const std::int64_t layers = cells / layer;  // nz - 1
-  std::vector<std::array<double, 2>> partial = block_partials(cells);
+  const std::int64_t ny = lat.shape.ny();
+  const std::int64_t layers = ny - 1;
   const bool parallel = cells >= detail::kParallelMinimum;
   const std::int64_t max_threads = parallel ? omp_get_max_threads() : 1;
   const std::int64_t scratch_per_thread = CellLayers::scratch_size(lat.shape);
   layer_buffers_.resize(static_cast<std::size_t>(max_threads * scratch_per_thread));
+  cell_energies_.resize(static_cast<std::size_t>(cells));
 
 #pragma omp parallel if (parallel)
   {
     const auto threads = static_cast<std::int64_t>(omp_get_num_threads());
     const auto thread = static_cast<std::int64_t>(omp_get_thread_num());
-    const ItemRange own = own_items(cells, thread, threads);
-    // Planes [plane_begin, plane_end): those whose first cell (plane x layer) is in own.
-    const std::int64_t plane_begin = (own.begin + layer - 1) / layer;
-    const std::int64_t plane_end = thread + 1 == threads ? nz : (own.end + layer - 1) / layer;
-    // Layers to compute: below the first plane, through the last plane's, and all own cells.
-    const std::int64_t layer_begin =
-        std::max<std::int64_t>(0, std::min(plane_begin - 1, own.begin / layer));
-    const std::int64_t layer_end =
-        std::min(layers, std::max(plane_end, own.end > own.begin ? (own.end - 1) / layer + 1 : 0));
+    // Node planes [plane_begin, plane_end); the layers from the one below the first plane
+    // through the last plane's; the energies of the layers of its own planes.
+    const std::int64_t plane_begin = ny * thread / threads;
+    const std::int64_t plane_end = ny * (thread + 1) / threads;
+    const std::int64_t layer_begin = std::max<std::int64_t>(0, plane_begin - 1);
+    const std::int64_t layer_end = std::min(layers, plane_end);
     CellLayers buffers(lat.shape, layer_buffers_.data() + thread * scratch_per_thread);
-    OwnBlockSums sums(own, partial);
     if (layer_begin < layer_end) buffers.load_plane(x, layer_begin);
-    for (std::int64_t cz = layer_begin; cz < layer_end; ++cz) {
-      buffers.load_plane(x, cz + 1);
-      buffers.compute_layer(cz, kappa, v0, force_factor, sums);
-      if (cz >= plane_begin && cz < plane_end) buffers.gather_plane(cz, gradient);
+    for (std::int64_t cy = layer_begin; cy < layer_end; ++cy) {
+      buffers.load_plane(x, cy + 1);
+      buffers.compute_layer(cy, kappa, v0, force_factor,
+                            cy >= plane_begin ? cell_energies_.data() : nullptr);
+      if (cy >= plane_begin) buffers.gather_plane(cy, gradient);
     }
     // The top plane holds cells of the last layer only.
-    if (plane_end == nz && plane_begin <= nz - 1) buffers.gather_plane(nz - 1, gradient);
+    if (plane_end == ny && plane_begin <= ny - 1) buffers.gather_plane(ny - 1, gradient);
   }
-  return total_of(partial);
+  const auto sums = detail::fixed_order_sums(
+      cells, [&](std::int64_t c) { return cell_energies_[static_cast<std::size_t>(c)]; });
+  return {sums[0], sums[1]};
 }
 
 void VolumeKernel::add_hessian_product(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,

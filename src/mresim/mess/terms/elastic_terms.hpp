@@ -162,8 +162,10 @@ class VolumeKernel {
   // Scratch of the Hessian product: per cell the three vectors t_a, t_b, t_c (see gather).
   mutable std::vector<double> scratch_;
   // evaluate_with_gradient's scratch per thread: two node planes, two layers of cell
-  // coefficients, a cell row's energies and a node row's gradients.
+  // coefficients, a layer's energies and a node line's gradients; and every cell's energy and
+  // rounding, in cell order (16 bytes per cell).
   mutable std::vector<double> layer_buffers_;
+  mutable std::vector<std::array<double, 2>> cell_energies_;
 };
 
 // Both kernels, as one evaluator of springs + volume (used by tests and benchmarks; the
