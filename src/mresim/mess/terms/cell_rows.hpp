@@ -1,8 +1,9 @@
 #pragma once
 
-// The volume terms over a row of cells along x, one SIMD lane per cell: the cells (cx, cy, cz)
-// for a run of consecutive cx, whose vertex positions come from planes of nodes stored x
-// fastest in three component arrays, so that each vertex of the run is a contiguous load. Each
+// The volume terms over a row of cells, one SIMD lane per cell: a run of cells consecutive along
+// one axis (z in the single-process kernel, VolumeKernel, and in the distributed one), whose
+// vertex positions come from node component arrays in which that axis runs fastest, so that
+// each vertex of the run is a contiguous load. Each
 // lane does the scalar operations of elastic::cell_value and elastic::vertex_gradient in the
 // same order, without fused multiply-adds (simd_clones.hpp): the results are bitwise those of
 // the scalar kernel.
