@@ -6,15 +6,11 @@
 // original run as it was and a staging directory that `mresim resume DIR` continues.
 // Under `mpirun -np P` the new steps' relaxations split over the processes, as `mresim run`'s do.
 
-#include <cstdio>
-#include <exception>
 #include <string>
 #include <vector>
 
 #include "cli/commands.hpp"
 #include "cli/finished_run.hpp"
-#include "mresim/app/run_type.hpp"
-#include "mresim/io/run_directory.hpp"
 #include "mresim/mess/restart/extend_plan.hpp"
 #include "mresim/mess/restart/restart_overrides.hpp"
 
@@ -50,22 +46,9 @@ int extend_command(const ExtendOptions& options) {
   // The plan validates the extended file as `mresim run` would, then checks the steps.
   const auto plan = mess_protocol::make_extend_plan(
       computed, extended, options.dir, new_history_entry("extend", words, options.overrides));
-  const std::string run_type = app::read_run_settings(extended).type;
-  if (job.size > 1) {
-    refuse_unsplittable_plan(*plan, run_type);
-    if (job.rank > 0) return participate_in_run(extended, *plan, options.threads, job, {});
-  }
-
-  try {
-    io::RunDirectory run_dir(options.dir);
-    std::printf("mresim: extending the run in %s\n", options.dir.c_str());
-    std::fflush(stdout);
-    return execute_and_publish(extended, *plan, run_type, run_dir, options.threads, options.no_plot,
-                               job);
-  } catch (const std::exception& e) {
-    end_job_on_error(e, job);  // the others may wait for the staging directory
-    throw;
-  }
+  return execute_on_finished_run(options.dir, extended, *plan,
+                                 "mresim: extending the run in " + options.dir, options.threads,
+                                 options.no_plot);
 }
 
 }  // namespace mresim::cli

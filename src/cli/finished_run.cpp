@@ -3,10 +3,13 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <exception>
 #include <mresim/core/version.hpp>
 #include <sstream>
 #include <stdexcept>
 
+#include "cli/commands.hpp"
 #include "mresim/io/hdf5_reader.hpp"
 #include "mresim/io/metadata.hpp"
 #include "mresim/io/run_directory.hpp"
@@ -81,6 +84,26 @@ mess_protocol::HistoryEntry new_history_entry(const std::string& kind,
   entry.overrides = overrides;
   entry.mresim_version = kVersion;
   return entry;
+}
+
+int execute_on_finished_run(const fs::path& dir, const config::TableReader& root,
+                            const app::RunPlan& plan, const std::string& announcement, long threads,
+                            bool no_plot) {
+  const mess::MpiJob job = mess::mpi_job();
+  const std::string run_type = app::read_run_settings(root).type;
+  if (job.size > 1) {
+    refuse_unsplittable_plan(plan, run_type);
+    if (job.rank > 0) return participate_in_run(root, plan, threads, job, {});
+  }
+  try {
+    io::RunDirectory run_dir(dir);
+    std::printf("%s\n", announcement.c_str());
+    std::fflush(stdout);
+    return execute_and_publish(root, plan, run_type, run_dir, threads, no_plot, job);
+  } catch (const std::exception& e) {
+    end_job_on_error(e, job);
+    throw;
+  }
 }
 
 }  // namespace mresim::cli

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "mresim/app/run_type.hpp"
 #include "mresim/config/table_reader.hpp"
 #include "mresim/mess/restart/run_history.hpp"
 
@@ -19,6 +20,15 @@ namespace mresim::cli {
 config::TableReader finished_run_file(const std::filesystem::path& dir,
                                       const std::vector<std::string>& more,
                                       const std::string& command);
+
+// Runs `plan` (an extend's or a rerun's) on the finished run in `dir` and publishes the
+// directory as `mresim run` does, `root` being the run file the results record. Under `mpirun
+// -np P` (P > 1) rank 0 does this; the other processes compute alongside it through
+// plan.participate() and write nothing; an error on any process ends the job (the others may
+// wait in a collective call). `announcement`: rank 0's first line on stdout.
+int execute_on_finished_run(const std::filesystem::path& dir, const config::TableReader& root,
+                            const app::RunPlan& plan, const std::string& announcement, long threads,
+                            bool no_plot);
 
 // A history entry of `kind` for this moment and this program, with its command line and overrides.
 mess_protocol::HistoryEntry new_history_entry(const std::string& kind,

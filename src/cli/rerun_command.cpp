@@ -3,15 +3,13 @@
 // step K; the original is kept in results.h5's /history. The directory is replaced all at once.
 // Under `mpirun -np P` the relaxations split over the processes, as `mresim run`'s do.
 
-#include <cstdio>
-#include <exception>
+#include <fmt/format.h>
+
 #include <string>
 #include <vector>
 
 #include "cli/commands.hpp"
 #include "cli/finished_run.hpp"
-#include "mresim/app/run_type.hpp"
-#include "mresim/io/run_directory.hpp"
 #include "mresim/mess/restart/rerun_plan.hpp"
 #include "mresim/mess/restart/restart_overrides.hpp"
 
@@ -51,24 +49,11 @@ int rerun_command(const RerunOptions& options) {
   const auto plan = mess_protocol::make_rerun_plan(
       computed, rerun, options.dir, static_cast<std::size_t>(options.step),
       new_history_entry("rerun", words, options.overrides));
-  const std::string run_type = app::read_run_settings(computed).type;
-  if (job.size > 1) {
-    refuse_unsplittable_plan(*plan, run_type);
-    if (job.rank > 0) return participate_in_run(rerun, *plan, options.threads, job, {});
-  }
-
-  try {
-    io::RunDirectory run_dir(options.dir);
-    std::printf("mresim: relaxing step %ld of the run in %s again\n", options.step,
-                options.dir.c_str());
-    std::fflush(stdout);
-    // The results record the run file the run was made with: the other steps are its results.
-    return execute_and_publish(computed, *plan, run_type, run_dir, options.threads, options.no_plot,
-                               job);
-  } catch (const std::exception& e) {
-    end_job_on_error(e, job);  // the others may wait in a collective call
-    throw;
-  }
+  // The results record the run file the run was made with: the other steps are its results.
+  return execute_on_finished_run(
+      options.dir, computed, *plan,
+      fmt::format("mresim: relaxing step {} of the run in {} again", options.step, options.dir),
+      options.threads, options.no_plot);
 }
 
 }  // namespace mresim::cli

@@ -184,6 +184,23 @@ void expect_same_steps(const fs::path& one, const fs::path& two) {
   EXPECT_EQ(files_in(one), files_in(two));
 }
 
+// `mresim <command> <one> <args>` by one process and `mpirun -np 2 mresim <command> <two>
+// <args>`, both succeeding, then expect_same_steps on the two directories. The two-process
+// run's stderr stays in dir/.stderr.
+void expect_one_and_two_processes_agree(const fs::path& dir, const std::string& command,
+                                        const std::string& one, const std::string& two,
+                                        const std::vector<std::string>& args) {
+  std::vector<std::string> single = {command, one};
+  single.insert(single.end(), args.begin(), args.end());
+  std::vector<std::string> split = {command, two};
+  split.insert(split.end(), args.begin(), args.end());
+  const Result r1 = run(dir, 0, single);
+  ASSERT_EQ(r1.status, 0) << r1.err;
+  const Result r2 = run(dir, 2, split);
+  ASSERT_EQ(r2.status, 0) << r2.err;
+  expect_same_steps(dir / one, dir / two);
+}
+
 // `mpirun -np 2 mresim extend` and `rerun` (docs/mpi.md): the same steps as one process.
 TEST(MpiRunCli, ExtendAndRerunOverProcessesGiveTheResultsOfOne) {
   if (!have_mpirun()) GTEST_SKIP() << "no MPI launcher (mpirun) found";
@@ -193,32 +210,15 @@ TEST(MpiRunCli, ExtendAndRerunOverProcessesGiveTheResultsOfOne) {
     fs::copy(dir / "base", dir / copy, fs::copy_options::recursive);
   }
   // The loop to 40 mT in 20 mT steps: five steps added to the six computed.
-  const std::vector<std::string> extend = {
-      "--no-plot", "-j", "1", "--set", "field.max=0.04", "--set", "field.steps=2"};
-  std::vector<std::string> extend_one = {"extend", "extend_one"};
-  extend_one.insert(extend_one.end(), extend.begin(), extend.end());
-  std::vector<std::string> extend_two = {"extend", "extend_two"};
-  extend_two.insert(extend_two.end(), extend.begin(), extend.end());
-  const Result e1 = run(dir.path(), 0, extend_one);
-  ASSERT_EQ(e1.status, 0) << e1.err;
-  const Result e2 = run(dir.path(), 2, extend_two);
-  ASSERT_EQ(e2.status, 0) << e2.err;
+  expect_one_and_two_processes_agree(
+      dir.path(), "extend", "extend_one", "extend_two",
+      {"--no-plot", "-j", "1", "--set", "field.max=0.04", "--set", "field.steps=2"});
   EXPECT_EQ(Hdf5Reader(dir / "extend_two" / "results.h5").doubles("/steps/centres").size(),
             11U * 2U * 3U);
-  expect_same_steps(dir / "extend_one", dir / "extend_two");
-
   // Step 2 (0 mT after 20 mT) relaxed again with a 100 times tighter force tolerance.
-  const std::vector<std::string> rerun = {
-      "--step", "2", "--no-plot", "-j", "1", "--set", "solver.minimiser.force_tolerance=1e-8"};
-  std::vector<std::string> rerun_one = {"rerun", "rerun_one"};
-  rerun_one.insert(rerun_one.end(), rerun.begin(), rerun.end());
-  std::vector<std::string> rerun_two = {"rerun", "rerun_two"};
-  rerun_two.insert(rerun_two.end(), rerun.begin(), rerun.end());
-  const Result r1 = run(dir.path(), 0, rerun_one);
-  ASSERT_EQ(r1.status, 0) << r1.err;
-  const Result r2 = run(dir.path(), 2, rerun_two);
-  ASSERT_EQ(r2.status, 0) << r2.err;
-  expect_same_steps(dir / "rerun_one", dir / "rerun_two");
+  expect_one_and_two_processes_agree(
+      dir.path(), "rerun", "rerun_one", "rerun_two",
+      {"--step", "2", "--no-plot", "-j", "1", "--set", "solver.minimiser.force_tolerance=1e-8"});
   // The rerun did relax step 2 again (tighter: a smaller largest force than the run's).
   EXPECT_LT(Hdf5Reader(dir / "rerun_two" / "results.h5").doubles("/steps/solver/max_force")[2],
             Hdf5Reader(dir / "base" / "results.h5").doubles("/steps/solver/max_force")[2]);
@@ -234,18 +234,11 @@ TEST(MpiRunCli, RerunThatComputesEarlierStepsAgainSplitsThemToo) {
   ASSERT_EQ(run(dir.path(), 0, args).status, 0);
   fs::copy(dir / "base", dir / "one", fs::copy_options::recursive);
   fs::copy(dir / "base", dir / "two", fs::copy_options::recursive);
-  const std::vector<std::string> rerun = {
-      "--step", "3", "--no-plot", "-j", "1", "--set", "solver.minimiser.force_tolerance=1e-8"};
-  std::vector<std::string> one = {"rerun", "one"};
-  one.insert(one.end(), rerun.begin(), rerun.end());
-  std::vector<std::string> two = {"rerun", "two"};
-  two.insert(two.end(), rerun.begin(), rerun.end());
-  const Result r1 = run(dir.path(), 0, one);
-  ASSERT_EQ(r1.status, 0) << r1.err;
-  const Result r2 = run(dir.path(), 2, two);
-  ASSERT_EQ(r2.status, 0) << r2.err;
-  EXPECT_NE(r2.err.find("steps 0 to 2 are computed again first"), std::string::npos) << r2.err;
-  expect_same_steps(dir / "one", dir / "two");
+  expect_one_and_two_processes_agree(
+      dir.path(), "rerun", "one", "two",
+      {"--step", "3", "--no-plot", "-j", "1", "--set", "solver.minimiser.force_tolerance=1e-8"});
+  const std::string err = read_text(dir / ".stderr");  // the two-process run's
+  EXPECT_NE(err.find("steps 0 to 2 are computed again first"), std::string::npos) << err;
 }
 
 // The processes of mpirun, i.e. its children (the launcher starts them directly on this
