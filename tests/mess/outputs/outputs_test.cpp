@@ -42,9 +42,14 @@ TEST(MessOutputs, ResultsSummaryAndXdmfAreConsistent) {
   // Physical profile, L-BFGS without a fallback: L-BFGS finished every step, no seed passes.
   EXPECT_EQ(h5.strings("/steps/solver/finished_by"), std::vector<std::string>(steps, "lbfgs"));
   EXPECT_EQ(h5.ints("/steps/solver/correction_passes"), std::vector<std::int64_t>(steps, 0));
-  // A field loop: the first step from the lattice, each later one from the step before.
-  std::vector<std::string> start(steps, "previous");
-  start[0] = "initial_lattice";
+  // A field loop: the first step from the lattice, the second from the step before, the later
+  // ones from the field secant through the two steps before (solver.field_step_start). It is
+  // kept where the loop turns (0.1 -> 0 T: back to the 0 T state) and rejected where the field
+  // passes zero (0 -> -0.1 T, 0 -> 0.1 T: the pair's response is even in B, so the secant points
+  // the wrong way).
+  const std::vector<std::string> start = {"initial_lattice", "previous",
+                                          "field_secant",    "previous_prediction_rejected",
+                                          "field_secant",    "previous_prediction_rejected"};
   EXPECT_EQ(h5.strings("/steps/solver/start"), start);
   // The measured peak memory of the run, absolute and per node: the
   // process held at least its lattice (positions alone are 24 bytes per node).

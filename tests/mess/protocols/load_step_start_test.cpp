@@ -16,6 +16,7 @@
 #include "../support/checkpoint_round_trip.hpp"
 #include "../support/mess_test_support.hpp"
 #include "../support/small_runs.hpp"
+#include "../support/start_comparison.hpp"
 #include "mresim/mess/outputs/checkpoint.hpp"
 #include "mresim/mess/profile/model_profile.hpp"
 #include "mresim/mess/protocols/protocol_runner.hpp"
@@ -136,16 +137,10 @@ std::string small_shear(const std::string& start) {
          (start.empty() ? "" : "\n[solver]\nload_step_start = \"" + start + "\"\n");
 }
 
-std::vector<StepRecord> run_all(const std::string& toml) {
-  ProtocolRunner runner(spec_of(toml));
-  ProtocolState state = runner.initial_state();
-  runner.run(state, nullptr);
-  return state.records;
-}
-
 TEST(LoadStepStart, PredictedStartsReachTheOriginalsStatesInFewerIterations) {
-  const std::vector<StepRecord> previous = run_all(small_shear("previous"));
-  const std::vector<StepRecord> predicted = run_all(small_shear(""));  // the default
+  const std::vector<StepRecord> previous = testing::records_of_run(small_shear("previous"));
+  const std::vector<StepRecord> predicted =
+      testing::records_of_run(small_shear(""));  // the default
   ASSERT_EQ(previous.size(), 10U);
   ASSERT_EQ(predicted.size(), previous.size());
 
@@ -159,19 +154,12 @@ TEST(LoadStepStart, PredictedStartsReachTheOriginalsStatesInFewerIterations) {
       step_start::kSecant};
   std::int64_t iterations_previous = 0;
   std::int64_t iterations_predicted = 0;
-  const double l_e = 1e-6;  // n_d = 1, R = 1.5 um
   for (std::size_t i = 0; i < previous.size(); ++i) {
     const StepRecord& a = previous[i];
     const StepRecord& b = predicted[i];
     EXPECT_EQ(a.start, i == 0 ? step_start::kInitialLattice : step_start::kPrevious);
     EXPECT_EQ(b.start, expected_start[i]) << "step " << i;
-    EXPECT_TRUE(a.converged && b.converged) << "step " << i;
-    // The same minimum to well within the force tolerance's reach (1e-6 k_eff l_e).
-    EXPECT_LT((a.centres - b.centres).cwiseAbs().maxCoeff(), 1e-6 * l_e) << "step " << i;
-    EXPECT_LT((a.magnetization - b.magnetization).cwiseAbs().maxCoeff(), 1e-6 * 1.6e6)
-        << "step " << i;
-    EXPECT_NEAR(a.energies.total(), b.energies.total(), 1e-6 * std::abs(a.energies.total()))
-        << "step " << i;
+    testing::expect_same_minimum(a, b, i, std::abs(a.energies.total()));
     iterations_previous += a.iterations;
     iterations_predicted += b.iterations;
   }
@@ -181,7 +169,7 @@ TEST(LoadStepStart, PredictedStartsReachTheOriginalsStatesInFewerIterations) {
 TEST(LoadStepStart, ResumedFromACheckpointEqualsTheUninterruptedRun) {
   const std::string toml = small_shear("");
   const mess_config::MessSpec spec = spec_of(toml);
-  const std::vector<StepRecord> full = run_all(toml);
+  const std::vector<StepRecord> full = testing::records_of_run(toml);
 
   const mresim::testing::TempDir dir;
   const auto checkpoint = dir / "checkpoint.h5";
@@ -189,13 +177,7 @@ TEST(LoadStepStart, ResumedFromACheckpointEqualsTheUninterruptedRun) {
   // Interrupted before the neighbour-field step 3 and the secant steps after it.
   ProtocolState resumed = testing::resumed_after(toml, 3, checkpoint, second);
   second.run(resumed, nullptr);
-  ASSERT_EQ(resumed.records.size(), full.size());
-  for (std::size_t i = 0; i < full.size(); ++i) {
-    EXPECT_EQ(resumed.records[i].start, full[i].start) << "step " << i;
-    EXPECT_EQ(resumed.records[i].centres, full[i].centres) << "step " << i;
-    EXPECT_EQ(resumed.records[i].energies.total(), full[i].energies.total()) << "step " << i;
-    EXPECT_EQ(resumed.records[i].iterations, full[i].iterations) << "step " << i;
-  }
+  testing::expect_same_records(resumed.records, full);
 }
 
 }  // namespace

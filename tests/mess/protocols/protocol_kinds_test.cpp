@@ -192,7 +192,11 @@ TEST(MessProtocolKinds, NewtonRunFollowsTheLbfgsLoop) {
     EXPECT_EQ(a.krylov_iterations, 0) << k;  // L-BFGS does no CG
     EXPECT_EQ(a.finished_by, "lbfgs") << k;
     EXPECT_EQ(b.finished_by, "newton") << k;
-    if (k > 0) {
+    if (k > 0 && a.iterations == 0) {
+      // Where the loop turns, the field secant starts from the result at the same field on the
+      // way up: apart, that is already the equilibrium for either method.
+      EXPECT_EQ(b.iterations, 0) << k;
+    } else if (k > 0) {
       EXPECT_LT(b.iterations, a.iterations) << k;  // Newton steps against L-BFGS steps
       // Newton's directions come from CG (recorded per step).
       if (b.iterations > 0) EXPECT_GT(b.krylov_iterations, 0) << k;

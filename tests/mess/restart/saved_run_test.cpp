@@ -5,6 +5,7 @@
 
 #include "mresim/mess/restart/saved_run.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -43,25 +44,41 @@ TEST(SavedRun, StepFilesAreReadOnlyWhenAStateNeedsThem) {
   ASSERT_EQ(steps, 3U);
 
   const mp::SavedRun saved = mp::read_saved_run(dir / "out", runner, toml);
-  // Steps 0 and 1 only in their step files; the last one also in the final state, held.
+  // Step 0 only in its step file; the last two also in the final state, held: its slot and
+  // the result before it, which the field secant of a next step needs.
+  ASSERT_TRUE(runner.keeps_earlier_field_result());
   ASSERT_EQ(saved.positions.size(), steps);
   EXPECT_TRUE(saved.positions.at(0).in_step_file());
-  EXPECT_TRUE(saved.positions.at(1).in_step_file());
+  EXPECT_FALSE(saved.positions.at(1).in_step_file());
   EXPECT_FALSE(saved.positions.at(steps - 1).in_step_file());
 
   // What load() reads is the step file's /positions, bit for bit.
-  const Hdf5Reader file(dir / "out" / "positions" / "step_000001.h5");
-  const std::vector<double> stored = file.doubles("/positions");
-  const Eigen::Matrix3Xd loaded = saved.positions.at(1).load();
+  // What load() reads is the step file's /positions, bit for bit, and the final state's copy of
+  // step 1 is the same array.
+  const auto step_file = [&](int k) {
+    return Hdf5Reader(dir / "out" / "positions" / fmt::format("step_{:06d}.h5", k))
+        .doubles("/positions");
+  };
+  const std::vector<double> stored = step_file(0);
+  const Eigen::Matrix3Xd loaded = saved.positions.at(0).load();
   ASSERT_EQ(static_cast<std::size_t>(loaded.size()), stored.size());
   EXPECT_TRUE(std::equal(stored.begin(), stored.end(), loaded.data()));
+  const std::vector<double> stored_1 = step_file(1);
+  const Eigen::Matrix3Xd held_1 = saved.positions.at(1).load();
+  EXPECT_TRUE(std::equal(stored_1.begin(), stored_1.end(), held_1.data()));
 
-  // The state after step 1 starts from that array and step 1's magnetizations.
+  // The state after step 1 starts from step 1's array and magnetizations, with step 0's array
+  // as the earlier field's result.
   const std::optional<mp::ProtocolState> state = mp::state_after(saved, runner, 2);
   ASSERT_TRUE(state.has_value());
   EXPECT_EQ(state->next_step, 2U);
-  EXPECT_TRUE(state->slots[0].positions.load() == loaded);
+  EXPECT_TRUE(state->slots[0].positions.load() == held_1);
   EXPECT_TRUE(state->slots[0].magnetization == saved.records[1].magnetization);
+  EXPECT_TRUE(state->earlier_field_result.load() == loaded);
+  // After step 0 there is no earlier result yet.
+  const std::optional<mp::ProtocolState> first = mp::state_after(saved, runner, 1);
+  ASSERT_TRUE(first.has_value());
+  EXPECT_EQ(first->earlier_field_result.cols(), 0);
 }
 
 TEST(SavedRun, StatesOfManyFieldsAreRebuiltParkedWhereTheRunnerParks) {

@@ -18,6 +18,9 @@ namespace {
 // 2: the records have box_strain (a version-1 checkpoint cannot be resumed).
 constexpr std::int64_t kFormatVersion = 2;
 
+// ProtocolState::earlier_field_result, where the state holds one.
+constexpr const char* kEarlierFieldResult = "/earlier_field_result";
+
 void write_optional(io::Hdf5File& file, const std::string& path, const Eigen::Matrix3Xd& m,
                     std::string_view unit) {
   if (m.cols() > 0) write_columns(file, path, m, unit);
@@ -57,6 +60,9 @@ void write_checkpoint(const fs::path& file, const ProtocolState& state,
     for (std::size_t i = 0; i < state.references.size(); ++i) {
       write_optional(out, fmt::format("/references/{}", i), state.references[i].load(), "m");
     }
+    if (state.earlier_field_result.cols() > 0) {
+      write_optional(out, kEarlierFieldResult, state.earlier_field_result.load(), "m");
+    }
     if (!state.records.empty()) {
       write_step_records(out, "/records", state.records, runner.system().particle_count(),
                          load_unit(runner.spec()), *runner.system().energy_labels());
@@ -95,6 +101,8 @@ ProtocolState read_checkpoint(const fs::path& file, const ProtocolRunner& runner
     state.references[i] = read_optional(in, fmt::format("/references/{}", i), nodes);
     runner.park_kept_positions(state);
   }
+  // Absent in checkpoints of runs without the field secant (and in those written before it).
+  state.earlier_field_result = read_optional(in, kEarlierFieldResult, nodes);
   if (next > 0) {
     state.records =
         read_step_records(in, "/records", runner.steps(), runner.system().particle_count(),

@@ -34,6 +34,25 @@ Eigen::Matrix3Xd secant_start(const Eigen::Matrix3Xd& previous, const Eigen::Mat
   return previous + ratio * (previous - zero_load);
 }
 
+Eigen::Matrix3Xd field_secant_start(const Eigen::Matrix3Xd& previous,
+                                    const Eigen::Matrix3Xd& earlier, const Eigen::Vector3d& b,
+                                    const Eigen::Vector3d& b_previous,
+                                    const Eigen::Vector3d& b_earlier) {
+  constexpr const char* kFn = "field_secant_start";
+  check_same_size(kFn, previous, earlier, "previous", "earlier");
+  const Eigen::Vector3d last_change = b_previous - b_earlier;
+  if (!b.allFinite() || !b_previous.allFinite() || !b_earlier.allFinite() ||
+      last_change.squaredNorm() == 0.0) {
+    throw std::invalid_argument(fmt::format(
+        "{}: fields B = ({}, {}, {}), B_previous = ({}, {}, {}), B_earlier = ({}, {}, {}) T: "
+        "all must be finite and B_previous != B_earlier",
+        kFn, b.x(), b.y(), b.z(), b_previous.x(), b_previous.y(), b_previous.z(), b_earlier.x(),
+        b_earlier.y(), b_earlier.z()));
+  }
+  const double ratio = (b - b_previous).dot(last_change) / last_change.squaredNorm();
+  return previous + ratio * (previous - earlier);
+}
+
 Eigen::Matrix3Xd neighbour_field_start(const Eigen::Matrix3Xd& zero_load,
                                        const Eigen::Matrix3Xd& neighbour_loaded,
                                        const Eigen::Matrix3Xd& neighbour_zero_load) {

@@ -1,7 +1,9 @@
 #pragma once
 
-// Where a loaded step of a strain run starts (run file: solver.load_step_start,
-// docs/run-files-3d.md; measured in docs/performance.md, "Strain steps from a predicted start").
+// Where a step of a 3D run starts: a loaded step of a strain run (run file:
+// solver.load_step_start) and a field step (solver.field_step_start); docs/run-files-3d.md,
+// measured in docs/performance.md ("Strain steps from a predicted start", "Field steps from a
+// predicted start").
 //
 // A strain run relaxes load value k at field f from the relaxed state at load value k - 1 and the
 // same field (protocol_runner.hpp), with the moved faces put at load value k. Started from that
@@ -18,10 +20,20 @@
 //    same strain, x = x_0(f) + (x_1(f - 1) - x_0(f - 1)) (neighbour_field_start);
 //  - k = 1 at the first field: the previous state (nothing to extrapolate from).
 //
+// A field step (every step of a field loop or series, the zero-load steps of strain and stress
+// runs) starts from the previous field's result x_{f-1}. From the third field on,
+// "extrapolated" starts it from the secant through the two previous fields' results instead,
+// in the applied field B (a vector; the change projected on the previous change):
+//        x = x_{f-1} + r (x_{f-1} - x_{f-2}),
+//        r = (B_f - B_{f-1}).(B_{f-1} - B_{f-2}) / |B_{f-1} - B_{f-2}|^2
+// (field_secant_start). Along a loop's leg this carries the polymer's response to the last
+// field change on to the next; where the loop turns (r = -1) it returns to the state of the
+// field before, x_{f-2}.
+//
 // The prediction is only where the relaxation starts; it ends at the same tolerance. The runner
-// keeps it only where its potential is not above that of the previous state with the new faces:
-// after a jump (a particle joining a cluster) the secant would carry the jump on and push
-// particles into each other, and such a step starts as before.
+// keeps it only where its potential is not above that of the previous state with the new faces
+// and field: after a jump (particles joining a cluster) the secant would carry the jump on and
+// push particles into each other, and such a step starts as before.
 
 #include <Eigen/Core>
 #include <string>
@@ -36,6 +48,7 @@ inline const std::string kInitialLattice = "initial_lattice";  // the run's firs
 inline const std::string kPrevious = "previous";  // the state the protocol prescribes, as it is
 inline const std::string kSecant = "secant";
 inline const std::string kNeighbourField = "neighbour_field";
+inline const std::string kFieldSecant = "field_secant";
 // A prediction was made and rejected (its potential was higher): started as "previous".
 inline const std::string kPredictionRejected = "previous_prediction_rejected";
 }  // namespace step_start
@@ -50,6 +63,14 @@ Eigen::Matrix3Xd secant_start(const Eigen::Matrix3Xd& previous, const Eigen::Mat
 Eigen::Matrix3Xd neighbour_field_start(const Eigen::Matrix3Xd& zero_load,
                                        const Eigen::Matrix3Xd& neighbour_loaded,
                                        const Eigen::Matrix3Xd& neighbour_zero_load);
+
+// x_{f-1} + r (x_{f-1} - x_{f-2}) with r as above, from the results `previous` (at field
+// `b_previous`) and `earlier` (at `b_earlier`). Throws std::invalid_argument if the arrays
+// differ in size, a field is not finite or b_previous == b_earlier.
+Eigen::Matrix3Xd field_secant_start(const Eigen::Matrix3Xd& previous,
+                                    const Eigen::Matrix3Xd& earlier, const Eigen::Vector3d& b,
+                                    const Eigen::Vector3d& b_previous,
+                                    const Eigen::Vector3d& b_earlier);
 
 // Moves `candidate` into the system where its potential is not above that of the system's own
 // positions, both at the system's field and constraints (the candidate's held coordinates are

@@ -137,12 +137,42 @@ const StepSpec& ProtocolRunner::step_at(std::size_t field_index, std::size_t loa
                          " and load value " + std::to_string(load_index));
 }
 
+bool ProtocolRunner::keeps_earlier_field_result() const {
+  return spec_.solver.field_step_start == mc::FieldStepStart::extrapolated &&
+         spec_.load_step_count() <= 1;
+}
+
+Eigen::Matrix3Xd ProtocolRunner::field_secant_candidate(const StepSpec& step,
+                                                        const ProtocolState& state) const {
+  if (step.load_index != 0 || step.field_index < 2) return {};
+  // x_{f-2}: with one slot the result kept before the slot's; else field f - 2's zero-load
+  // result. x_{f-1} is the step's start, which the system holds.
+  const KeptPositions& earlier = state.slots.size() == 1
+                                     ? state.earlier_field_result
+                                     : state.references.at(step.field_index - 2);
+  if (earlier.cols() == 0) return {};
+  const Eigen::Vector3d& b_previous = step_at(step.field_index - 1, 0).field;
+  const Eigen::Vector3d& b_earlier = step_at(step.field_index - 2, 0).field;
+  if (b_previous == b_earlier) return {};  // a repeated field: nothing to extrapolate
+  return field_secant_start(system_.positions(), earlier.load(), step.field, b_previous, b_earlier);
+}
+
 std::string ProtocolRunner::predict_start(const StepSpec& step, const ProtocolState& state,
                                           std::int64_t& evaluations) {
   if (start_state(step, state) == nullptr) return step_start::kInitialLattice;
+  if (step.load_index == 0) {
+    if (spec_.solver.field_step_start != mc::FieldStepStart::extrapolated) {
+      return step_start::kPrevious;
+    }
+    Eigen::Matrix3Xd candidate = field_secant_candidate(step, state);
+    if (candidate.cols() == 0) return step_start::kPrevious;
+    evaluations += 2;
+    return take_if_not_higher(system_, candidate) ? step_start::kFieldSecant
+                                                  : step_start::kPredictionRejected;
+  }
   const Protocol& protocol = *spec_.protocol;
   const bool first_field = step.field_index == 0;
-  if (spec_.solver.load_step_start != mc::LoadStepStart::extrapolated || step.load_index == 0 ||
+  if (spec_.solver.load_step_start != mc::LoadStepStart::extrapolated ||
       !protocol.loads_from_zero_load_state() || (step.load_index == 1 && first_field)) {
     return step_start::kPrevious;
   }
@@ -189,6 +219,12 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   LoadState load = protocol.load(lat, step, loaded ? reference_of_field() : lat.positions);
 
   SlotState& slot = state.slots[slot_of_field(step.field_index)];
+  // With one slot, the field secant of the next field needs this step's start (the previous
+  // field's result) after the step, when the slot holds this step's result.
+  Eigen::Matrix3Xd start_to_keep;
+  if (keeps_earlier_field_result() && slot.positions.cols() > 0) {
+    start_to_keep = slot.positions.load();
+  }
   system_.set_constraints(std::move(load.constraints));
   system_.set_applied_forces(load.applied_forces);
   set_start(step, state);
@@ -199,6 +235,9 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   record.step = step;
   std::int64_t prediction_evaluations = 0;
   record.start = predict_start(step, state, prediction_evaluations);
+  // The secant has been made: its earlier point is not held while the step relaxes (this step's
+  // start takes its place after the step).
+  if (keeps_earlier_field_result()) state.earlier_field_result = KeptPositions();
   const double b = step.field.norm();
   if (spec_.solver.method != mc::SolverMethod::leapfrog) {
     const mess::MinimiserResult r = mess::minimise(system_, minimiser_options());
@@ -249,6 +288,7 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
                                step.load_index > 0 ? reference_of_field() : system_.positions());
 
   // Advance the state.
+  if (keeps_earlier_field_result()) state.earlier_field_result = std::move(start_to_keep);
   slot.positions = system_.positions();
   slot.magnetization = system_.magnetizations();
   if (step.load_index == 0 && !state.references.empty()) {

@@ -14,6 +14,9 @@
 //    Strain runs with solver.load_step_start = "extrapolated" (the default) move that state to a
 //    prediction of the new one first (load_step_start.hpp); the relaxation ends at the same
 //    tolerance.
+//  - field steps from the third field on, with solver.field_step_start = "extrapolated" (the
+//    default): from the secant through the two previous fields' results (load_step_start.hpp),
+//    where its potential is not higher.
 // The zero-load result at each field is the reference configuration of the loaded steps at that
 // field (strain values are applied relative to it; a stress run's strain is measured from it).
 //
@@ -92,7 +95,12 @@ struct ProtocolState {
   std::size_t next_step = 0;
   std::vector<SlotState> slots;           // one per field for strain/stress runs, else one
   std::vector<KeptPositions> references;  // zero-load result per field (0 columns: unset)
-  std::vector<StepRecord> records;        // of steps 0 .. next_step - 1
+  // Runs with one slot (field loops and series) and solver.field_step_start = "extrapolated":
+  // the result of the field step before the one the slot holds (0 columns: none yet), the
+  // second point of the field secant (load_step_start.hpp). Runs with a slot per field take it
+  // from `references`.
+  KeptPositions earlier_field_result;
+  std::vector<StepRecord> records;  // of steps 0 .. next_step - 1
   // Where the positions of the fields a step does not work on are parked (kept_positions.hpp);
   // null: all in memory. ProtocolRunner::run_next_step creates it when the runner has a
   // scratch directory (set_scratch_directory) and the state has more than one slot.
@@ -109,6 +117,10 @@ class ProtocolRunner {
   const mess::MessSystem& system() const { return system_; }
 
   ProtocolState initial_state() const;
+
+  // Whether the run's states keep ProtocolState::earlier_field_result (one slot, and
+  // solver.field_step_start = "extrapolated"): after step k it holds step k - 1's result.
+  bool keeps_earlier_field_result() const;
 
   // Runs step state.next_step and advances the state. Throws std::logic_error past the end.
   const StepRecord& run_next_step(ProtocolState& state);
@@ -147,14 +159,18 @@ class ProtocolRunner {
   // Puts the step's start (start_state: positions and magnetizations; the initial lattice
   // without one) into the system, then parks the kept positions.
   void set_start(const StepSpec& step, ProtocolState& state);
-  // Strain runs with solver.load_step_start = "extrapolated": replaces the start of a loaded
-  // step by its prediction (load_step_start.hpp) where that has no higher potential. Call with
-  // the step's field and boundary set. Returns how the step starts (step_start::); adds the
-  // evaluations it made to `evaluations`.
   // The planned step at this field and load value; std::logic_error if there is none.
   const StepSpec& step_at(std::size_t field_index, std::size_t load_index) const;
+  // Replaces the start of a loaded step of a strain run (solver.load_step_start) or of a field
+  // step (solver.field_step_start) by its prediction (load_step_start.hpp) where that has no
+  // higher potential. Call with the step's field and boundary set. Returns how the step starts
+  // (step_start::); adds the evaluations it made to `evaluations`.
   std::string predict_start(const StepSpec& step, const ProtocolState& state,
                             std::int64_t& evaluations);
+  // The field secant's start for a field step (load_step_start.hpp), or an empty array where
+  // it has no two earlier fields' results.
+  Eigen::Matrix3Xd field_secant_candidate(const StepSpec& step, const ProtocolState& state) const;
+
   // The run file's solver settings for one relaxation, with the run's caches.
   mess::MinimiserOptions minimiser_options() const;
 

@@ -45,6 +45,11 @@ void take_final_state(ProtocolState& final, const std::vector<StepSpec>& steps,
                                  SavedPositions(std::move(final.references[f])));
     }
   }
+  // One slot: the result of the step before the last (ProtocolState::earlier_field_result).
+  if (final.next_step >= 2 && final.earlier_field_result.cols() > 0) {
+    positions.insert_or_assign(final.next_step - 2,
+                               SavedPositions(std::move(final.earlier_field_result)));
+  }
 }
 
 }  // namespace
@@ -93,16 +98,21 @@ Eigen::Matrix3Xd SavedPositions::load() const {
 
 namespace {
 
-// The steps whose results the state after `count` steps holds: the latest step of each slot and
-// the zero-load step of each field (nullopt: untouched, the initial lattice).
+// The steps whose results the state after `count` steps holds: the latest step of each slot,
+// the zero-load step of each field and, where the runner keeps one, the step before the slot's
+// latest (nullopt: untouched, the initial lattice; none).
 struct StateSources {
   std::vector<std::optional<std::size_t>> slots;
   std::vector<std::optional<std::size_t>> references;
+  std::optional<std::size_t> earlier_field_result;
 };
 
-StateSources sources_after(const SavedRun& saved, const ProtocolState& initial, std::size_t count) {
+StateSources sources_after(const SavedRun& saved, const ProtocolRunner& runner,
+                           const ProtocolState& initial, std::size_t count) {
   StateSources sources{std::vector<std::optional<std::size_t>>(initial.slots.size()),
-                       std::vector<std::optional<std::size_t>>(initial.references.size())};
+                       std::vector<std::optional<std::size_t>>(initial.references.size()),
+                       std::nullopt};
+  if (runner.keeps_earlier_field_result() && count >= 2) sources.earlier_field_result = count - 2;
   for (std::size_t k = 0; k < count; ++k) {
     const StepSpec& step = saved.steps[k];
     sources.slots.at(slot_of(step, initial.slots.size())) = k;
@@ -118,10 +128,12 @@ bool kept(const SavedRun& saved, const std::vector<std::optional<std::size_t>>& 
                              [&](const auto& k) { return !k || saved.positions.contains(*k); });
 }
 
-bool restorable(const SavedRun& saved, const ProtocolState& initial, std::size_t count) {
+bool restorable(const SavedRun& saved, const ProtocolRunner& runner, const ProtocolState& initial,
+                std::size_t count) {
   if (count > saved.records.size() || count > saved.steps.size()) return false;
-  const StateSources sources = sources_after(saved, initial, count);
-  return kept(saved, sources.slots) && kept(saved, sources.references);
+  const StateSources sources = sources_after(saved, runner, initial, count);
+  return kept(saved, sources.slots) && kept(saved, sources.references) &&
+         kept(saved, {sources.earlier_field_result});
 }
 
 }  // namespace
@@ -129,8 +141,10 @@ bool restorable(const SavedRun& saved, const ProtocolState& initial, std::size_t
 std::optional<ProtocolState> state_after(const SavedRun& saved, const ProtocolRunner& runner,
                                          std::size_t count) {
   ProtocolState state = runner.initial_state();
-  if (count > runner.steps().size() || !restorable(saved, state, count)) return std::nullopt;
-  const StateSources sources = sources_after(saved, state, count);
+  if (count > runner.steps().size() || !restorable(saved, runner, state, count)) {
+    return std::nullopt;
+  }
+  const StateSources sources = sources_after(saved, runner, state, count);
   for (std::size_t s = 0; s < state.slots.size(); ++s) {
     if (!sources.slots[s]) continue;
     state.slots[s].positions = saved.positions.at(*sources.slots[s]).load();
@@ -142,6 +156,9 @@ std::optional<ProtocolState> state_after(const SavedRun& saved, const ProtocolRu
     state.references[f] = saved.positions.at(*sources.references[f]).load();
     runner.park_kept_positions(state);
   }
+  if (sources.earlier_field_result) {
+    state.earlier_field_result = saved.positions.at(*sources.earlier_field_result).load();
+  }
   state.records.assign(saved.records.begin(),
                        saved.records.begin() + static_cast<std::ptrdiff_t>(count));
   state.next_step = count;
@@ -152,7 +169,7 @@ std::size_t last_restorable(const SavedRun& saved, const ProtocolRunner& runner,
                             std::size_t count) {
   const ProtocolState initial = runner.initial_state();
   for (std::size_t k = std::min(count, runner.steps().size()); k > 0; --k) {
-    if (restorable(saved, initial, k)) return k;
+    if (restorable(saved, runner, initial, k)) return k;
   }
   return 0;
 }

@@ -273,6 +273,12 @@ void describe_solver(const MessSpec& s, app::InfoReport& r) {
                               "zero-strain state, or the previous field's response)"
                             : "each strain starts from the previous one's state (the original)");
   }
+  const bool field_extrapolated = v.field_step_start == FieldStepStart::extrapolated;
+  r.add_text(sec, "field_step_start", field_extrapolated ? "extrapolated" : "previous",
+             field_extrapolated
+                 ? "each field from the third on starts from the secant through the two "
+                   "previous fields' results"
+                 : "each field starts from the previous field's result (the original)");
   const magnetism::MagnetizationOptions& m = v.magnetization;
   const std::string tolerance = magnetization_tolerance_name(m);
   r.add_text(sec, "magnetization_tolerance", tolerance,

@@ -172,10 +172,18 @@ std::optional<double> leapfrog_stability_limit(int discretization_order);
 // from the previous load value's state as it is (the original code).
 enum class LoadStepStart { extrapolated, previous };
 
+// Where a field step (every step of a field loop or series; the zero-load steps of strain and
+// stress runs) from the third field on starts (protocols/load_step_start.hpp): from the secant
+// through the two previous fields' results, or from the previous field's result as it is (the
+// original code).
+enum class FieldStepStart { extrapolated, previous };
+
 struct SolverSpec {
   SolverMethod method = SolverMethod::minimiser;
   // Default: extrapolated, except with the leapfrog (which reproduces the original: previous).
   LoadStepStart load_step_start = LoadStepStart::extrapolated;
+  // Default: extrapolated, except with the leapfrog (previous).
+  FieldStepStart field_step_start = FieldStepStart::extrapolated;
   MinimiserSettings minimiser;
   LeapfrogSettings leapfrog;
   // atol, rtol, iteration budgets; `demagnetization` mirrors MessSpec::demagnetization.

@@ -540,7 +540,8 @@ void read_solver(const std::optional<TableReader>& solver, bool demagnetization,
              : method == "newton" ? SolverMethod::newton
              : method == "lbfgs"  ? SolverMethod::lbfgs
                                   : SolverMethod::minimiser;
-  // The leapfrog reproduces the original code, which starts each strain from the previous one.
+  // The leapfrog reproduces the original code, which starts each strain and each field from the
+  // previous one.
   const LoadStepStart start_default =
       s.method == SolverMethod::leapfrog ? LoadStepStart::previous : LoadStepStart::extrapolated;
   if (t.has("load_step_start") && !loads_from_zero_load) {
@@ -551,6 +552,10 @@ void read_solver(const std::optional<TableReader>& solver, bool demagnetization,
   s.load_step_start = t.enumeration_or(
       "load_step_start", start_default,
       {{"extrapolated", LoadStepStart::extrapolated}, {"previous", LoadStepStart::previous}});
+  s.field_step_start = t.enumeration_or(
+      "field_step_start",
+      s.method == SolverMethod::leapfrog ? FieldStepStart::previous : FieldStepStart::extrapolated,
+      {{"extrapolated", FieldStepStart::extrapolated}, {"previous", FieldStepStart::previous}});
   // [solver.minimiser] holds the criteria of lbfgs and newton alike.
   const std::string other = method == "leapfrog" ? "minimiser" : "leapfrog";
   if (t.has(other)) {
