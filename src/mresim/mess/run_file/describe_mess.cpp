@@ -340,9 +340,11 @@ void describe_mess(const MessSpec& s, app::InfoReport& r) {
   r.add_integer("output", "checkpoint_every", s.output.checkpoint_every, "steps",
                 s.output.checkpoint_every == 0 ? "no checkpoints" : "");
   // final_state.h5: the positions of every slot (one per field with a load) and the zero-load
-  // references, float64 (restart/saved_run.hpp).
-  const double slots =
-      s.load_step_count() > 1 ? 2.0 * static_cast<double>(s.field.values.size()) : 1.0;
+  // references, float64 (restart/saved_run.hpp); with one slot and predicted field steps also
+  // the result before the last (ProtocolState::earlier_field_result).
+  const bool earlier_result = s.solver.field_step_start == FieldStepStart::extrapolated;
+  const double slots = s.load_step_count() > 1 ? 2.0 * static_cast<double>(s.field.values.size())
+                                               : (earlier_result ? 2.0 : 1.0);
   r.add_text("output", "keep_final_state", s.output.keep_final_state ? "on" : "off",
              s.output.keep_final_state
                  ? fmt::format("final_state.h5 of {:.3g} MB, for mresim extend and rerun",
