@@ -246,6 +246,14 @@ void describe_solver(const MessSpec& s, app::InfoReport& r) {
     r.add(sec, "force_tolerance", v.minimiser.force_tolerance, "k_eff l_e",
           "largest net force on a free node");
     r.add_integer(sec, "max_iterations", v.minimiser.max_iterations);
+    if (v.method == SolverMethod::minimiser) {
+      const bool blocks = v.node_scaling == mess::NodeScaling::blocks;
+      r.add_text(sec, "node_scaling", blocks ? "blocks" : "diagonal",
+                 blocks ? "the multilevel preconditioner inverts each polymer node's 3 x 3 "
+                          "stiffness block"
+                        : "the multilevel preconditioner inverts each node's diagonal (before "
+                          "the blocks)");
+    }
   } else {
     const lattice::LatticeSpec& l = s.lattice;
     const double l_e = s.geometry.element_length;

@@ -31,6 +31,7 @@
 #include "mresim/mess/magnetization/magnetic_particles.hpp"
 #include "mresim/mess/magnetization/self_consistent.hpp"
 #include "mresim/mess/profile/model_profile.hpp"
+#include "mresim/mess/solvers/node_scaling.hpp"
 #include "mresim/mess/terms/energy_term.hpp"
 #include "mresim/mess/terms/magnetic_energy.hpp"
 
@@ -184,6 +185,9 @@ struct SolverSpec {
   LoadStepStart load_step_start = LoadStepStart::extrapolated;
   // Default: extrapolated, except with the leapfrog (previous).
   FieldStepStart field_step_start = FieldStepStart::extrapolated;
+  // method = "minimiser" only: how its multilevel preconditioner (from 40,000 nodes) scales the
+  // polymer's nodes (solvers/node_scaling.hpp).
+  mess::NodeScaling node_scaling = mess::NodeScaling::blocks;
   MinimiserSettings minimiser;
   LeapfrogSettings leapfrog;
   // atol, rtol, iteration budgets; `demagnetization` mirrors MessSpec::demagnetization.

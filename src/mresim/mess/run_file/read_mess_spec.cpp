@@ -556,6 +556,16 @@ void read_solver(const std::optional<TableReader>& solver, bool demagnetization,
       "field_step_start",
       s.method == SolverMethod::leapfrog ? FieldStepStart::previous : FieldStepStart::extrapolated,
       {{"extrapolated", FieldStepStart::extrapolated}, {"previous", FieldStepStart::previous}});
+  // Only the minimiser's multilevel preconditioner scales nodes by blocks; the other methods
+  // would ignore the choice.
+  if (t.has("node_scaling") && s.method != SolverMethod::minimiser) {
+    t.fail("node_scaling", t.value_text("node_scaling"),
+           fmt::format(R"(only read with solver.method = "minimiser" (the method is "{}"))",
+                       method));
+  }
+  s.node_scaling = t.enumeration_or(
+      "node_scaling", mess::NodeScaling::blocks,
+      {{"blocks", mess::NodeScaling::blocks}, {"diagonal", mess::NodeScaling::diagonal}});
   // [solver.minimiser] holds the criteria of lbfgs and newton alike.
   const std::string other = method == "leapfrog" ? "minimiser" : "leapfrog";
   if (t.has(other)) {

@@ -324,11 +324,12 @@ class Minimisation {
           options.distributed != nullptr ? options.distributed->vector_split().get() : nullptr;
       preconditioner_ =
           options.preconditioner_cache != nullptr
-              ? options.preconditioner_cache->get(system, map, force_scale, multilevel, processes)
+              ? options.preconditioner_cache->get(system, map, force_scale, multilevel, processes,
+                                                  options.node_scaling)
               : std::make_shared<const RigidParticlePreconditioner>(
                     system, map, force_scale, multilevel,
                     multilevel ? &system.positions() : nullptr,  // as the cache builds it
-                    processes);
+                    processes, options.node_scaling);
     }
     const bool single = options.lbfgs_history == LbfgsHistoryPrecision::single_precision ||
                         (options.lbfgs_history == LbfgsHistoryPrecision::automatic && multilevel);

@@ -60,6 +60,7 @@
 #include <string>
 
 #include "mresim/mess/solvers/amg_preconditioner.hpp"
+#include "mresim/mess/solvers/node_scaling.hpp"
 #include "mresim/mess/solvers/relaxation_observer.hpp"
 #include "mresim/mess/system/system_energy.hpp"
 
@@ -146,6 +147,10 @@ struct MinimiserOptions {
   bool precondition = true;
   LbfgsPreconditioner lbfgs_preconditioner = LbfgsPreconditioner::automatic;
   LbfgsHistoryPrecision lbfgs_history = LbfgsHistoryPrecision::automatic;
+  // How the multilevel preconditioner scales the polymer's nodes (preconditioner.hpp: the
+  // inverse of each node's 3 x 3 stiffness block, or of its diagonal); the rigid-particle
+  // preconditioner alone, built at rest, has the diagonal either way.
+  NodeScaling node_scaling = NodeScaling::blocks;
   // multilevel and rigid_particles: where the preconditioner is kept between calls (a caller
   // relaxing many steps of one system keeps one; null: built anew in every call).
   std::shared_ptr<PreconditionerCache> preconditioner_cache;

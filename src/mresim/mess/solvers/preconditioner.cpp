@@ -1,5 +1,6 @@
 #include "mresim/mess/solvers/preconditioner.hpp"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <Eigen/QR>
 #include <bit>
@@ -15,23 +16,34 @@ RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& syste
                                                          const DofMap& map, double force_scale,
                                                          bool multilevel,
                                                          const Eigen::Matrix3Xd* state,
-                                                         const detail::BlockSplit* processes) {
+                                                         const detail::BlockSplit* processes,
+                                                         NodeScaling node_scaling) {
   const lattice::Lattice& lat = system.lattice();
   // Where the particles' rigid motions are taken: the state, or the reference lattice.
   const Eigen::Matrix3Xd& x = state != nullptr ? *state : lat.positions;
   const double l_e = lat.element_length;
   const double volume_force_factor = system.settings().elastic.volume_force_factor;
-  // Hessian diagonal per node coordinate (N/m) of the stiffness terms (stiffness_terms.hpp).
+  // Hessian diagonal per node coordinate (N/m) of the stiffness terms (stiffness_terms.hpp), and
+  // where the node blocks are asked for, each node block's off-diagonal entries (xy, xz, yz).
   Eigen::Matrix3Xd d = Eigen::Matrix3Xd::Zero(3, lat.node_count());
+  const bool blocks = state != nullptr && node_scaling == NodeScaling::blocks;
+  Eigen::Matrix3Xd off = Eigen::Matrix3Xd::Zero(3, blocks ? lat.node_count() : 0);
+  const auto add_off_diagonal = [&off](std::int64_t n, const Eigen::Vector3d& u, double c) {
+    off.col(n) += c * Eigen::Vector3d(u.x() * u.y(), u.x() * u.z(), u.y() * u.z());
+  };
   // At rest the cells' diagonal is the one constant below (kept as it always was computed, so
   // that a preconditioner built at rest has the same bits as before the states existed).
   const double cell_at_rest = volume_force_factor * std::abs(lat.polymer.kappa) * l_e / 16.0;
   for_each_stiffness_term(
       lat, state, map, volume_force_factor, 1.0,
-      [&d](std::int64_t i, std::int64_t j, const Eigen::Vector3d& u, double c) {
+      [&](std::int64_t i, std::int64_t j, const Eigen::Vector3d& u, double c) {
         const Eigen::Vector3d h = c * u.cwiseAbs2();
         d.col(i) += h;
         d.col(j) += h;
+        if (blocks) {
+          add_off_diagonal(i, u, c);
+          add_off_diagonal(j, u, c);
+        }
       },
       [&](const auto& element, const lattice::CellVertices& g, double c) {
         for (std::size_t v = 0; v < 8; ++v) {
@@ -39,6 +51,7 @@ RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& syste
             d.col(element[v]).array() += cell_at_rest;
           } else {
             d.col(element[v]) += c * g[v].cwiseAbs2();
+            if (blocks) add_off_diagonal(element[v], g[v], c);
           }
         }
       });
@@ -65,6 +78,7 @@ RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& syste
     if (!(diagonal[k] > 0.0)) diagonal[k] = 1.0;
   }
   inverse_diagonal_ = diagonal.cwiseInverse();
+  if (blocks) invert_node_blocks(lat, map, d, off, scale);
   rigid_stiffness_ = polymer_count > 0 ? polymer_sum / static_cast<double>(polymer_count) : 1.0;
 
   // Rigid-motion bases of the particles whose coordinates are all plain free dofs.
@@ -107,10 +121,55 @@ RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& syste
   }
 }
 
+void RigidParticlePreconditioner::invert_node_blocks(const lattice::Lattice& lat,
+                                                     const DofMap& map,
+                                                     const Eigen::Matrix3Xd& diagonal,
+                                                     const Eigen::Matrix3Xd& off, double scale) {
+  for (std::int64_t n = 0; n < lat.node_count(); ++n) {
+    if (!lat.particle_of_node.empty() && lat.particle_of_node[static_cast<std::size_t>(n)] >= 0) {
+      continue;  // the particles' blocks (their rigid motions) take these dofs
+    }
+    const Eigen::Index first = map.dof_of(n, 0);
+    if (first < 0 || map.dof_of(n, 1) != first + 1 || map.dof_of(n, 2) != first + 2 ||
+        map.is_group_dof(first)) {
+      continue;
+    }
+    Eigen::Matrix3d b;
+    b.diagonal() = diagonal.col(n);
+    b(0, 1) = b(1, 0) = off(0, n);
+    b(0, 2) = b(2, 0) = off(1, n);
+    b(1, 2) = b(2, 1) = off(2, n);
+    b *= scale;
+    const Eigen::LLT<Eigen::Matrix3d> factor(b);
+    const Eigen::Vector3d pivots = factor.matrixL().toDenseMatrix().diagonal();
+    if (factor.info() != Eigen::Success || !(pivots.minCoeff() > 0.0) ||
+        pivots.minCoeff() * pivots.minCoeff() < 1e-8 * b.diagonal().maxCoeff()) {
+      continue;  // not safely positive definite: the diagonal
+    }
+    const Eigen::Matrix3d inverse = factor.solve(Eigen::Matrix3d::Identity());
+    for (int a = 0; a < 3; ++a) inverse_diagonal_[first + a] = inverse(a, a);
+    node_blocks_.push_back({first, 0.5 * (inverse(0, 1) + inverse(1, 0)),
+                            0.5 * (inverse(0, 2) + inverse(2, 0)),
+                            0.5 * (inverse(1, 2) + inverse(2, 1))});
+  }
+}
+
 Eigen::VectorXd RigidParticlePreconditioner::apply(const DofMap& map,
                                                    const Eigen::VectorXd& v) const {
   Eigen::VectorXd w;
   detail::parallel_product(inverse_diagonal_, v, w);  // both cores: a million dofs at full size
+  // The node blocks' off-diagonal entries; each block writes only its own node's entries.
+  const auto block_count = static_cast<std::int64_t>(node_blocks_.size());
+#pragma omp parallel for schedule(static) if (block_count >= detail::kParallelMinimum)
+  for (std::int64_t i = 0; i < block_count; ++i) {
+    const NodeBlock& b = node_blocks_[static_cast<std::size_t>(i)];
+    const double x = v[b.first];
+    const double y = v[b.first + 1];
+    const double z = v[b.first + 2];
+    w[b.first] += b.xy * y + b.xz * z;
+    w[b.first + 1] += b.xy * x + b.yz * z;
+    w[b.first + 2] += b.xz * x + b.yz * y;
+  }
   for (const Block& b : blocks_) {
     const auto m = static_cast<Eigen::Index>(b.dofs.size());
     Eigen::VectorXd vp(m);
@@ -165,12 +224,12 @@ std::uint64_t preconditioner_key(const MessSystem& system, const DofMap& map, do
 
 std::shared_ptr<const RigidParticlePreconditioner> PreconditionerCache::get(
     const MessSystem& system, const DofMap& map, double force_scale, bool multilevel,
-    const detail::BlockSplit* processes) {
+    const detail::BlockSplit* processes, NodeScaling node_scaling) {
   const std::uint64_t key = preconditioner_key(system, map, force_scale, multilevel);
   if (multilevel) {
     kept_.reset();  // before the new one is built: never two at once
-    kept_ = std::make_shared<const RigidParticlePreconditioner>(system, map, force_scale, true,
-                                                                &system.positions(), processes);
+    kept_ = std::make_shared<const RigidParticlePreconditioner>(
+        system, map, force_scale, true, &system.positions(), processes, node_scaling);
     lattice_ = &system.lattice();
     key_ = key;
     ++builds_;

@@ -25,6 +25,22 @@
 // diagonal leaves slow. Also symmetric positive definite. Where the lattice holds no coordinate
 // (so C would be singular) it is left out.
 //
+// Node blocks. Where P is built at a state (the multilevel preconditioner, below), each polymer
+// node whose three coordinates are free takes the inverse of its 3 x 3 block of the stiffness
+// terms (the sum of c u u^T over its springs and c g_v g_v^T over its cells) in place of the
+// inverse of that block's diagonal (NodeScaling::blocks, the default). In contact the polymer
+// between the particles is compressed and sheared, so a node's stiffness is strongly
+// anisotropic with principal directions off the lattice axes, which a diagonal cannot describe:
+// on four steps of the full-size Fig. 4.11 loop the blocks took 14-21 % fewer L-BFGS iterations
+// (docs/performance.md, "Node blocks in the multilevel preconditioner"). Each block is a sum of
+// positive semi-definite terms; one that is not safely positive definite (its Cholesky factor's
+// smallest pivot below 1e-8 of its largest diagonal entry) keeps its diagonal. So P stays
+// symmetric positive definite. The blocks' off-diagonal entries cost 32 bytes per node (the
+// diagonal of each inverse block takes the place of D^-1). NodeScaling::diagonal keeps the
+// diagonal everywhere (the preconditioner before the blocks, kept to measure against). Built at
+// rest, P has the diagonal whatever the choice: at rest an interior node's springs and cells
+// are symmetric about it, and its block is diagonal.
+//
 // Built at rest (the reference lattice), P depends only on the lattice, the free coordinates and
 // the force scale, so a run relaxing many steps keeps one (PreconditionerCache) while its free
 // coordinates stay: the plain P of `method = "lbfgs"` and of small lattices. With the multilevel
@@ -37,6 +53,7 @@
 #include <vector>
 
 #include "mresim/mess/solvers/multilevel_correction.hpp"
+#include "mresim/mess/solvers/node_scaling.hpp"
 #include "mresim/mess/system/constraints.hpp"
 #include "mresim/mess/system/system_energy.hpp"
 
@@ -50,9 +67,11 @@ class RigidParticlePreconditioner {
   // (stiffness_terms.hpp) and the particles' rigid motions taken; null: the reference lattice.
   // `processes`: the MPI processes that share the multilevel correction's build
   // (multilevel_correction.hpp; collective on them), null: this process alone.
+  // `node_scaling`: used where `state` is given (header).
   RigidParticlePreconditioner(const MessSystem& system, const DofMap& map, double force_scale,
                               bool multilevel = false, const Eigen::Matrix3Xd* state = nullptr,
-                              const detail::BlockSplit* processes = nullptr);
+                              const detail::BlockSplit* processes = nullptr,
+                              NodeScaling node_scaling = NodeScaling::blocks);
 
   // P v. `map`: one with the same free coordinates and groups as the constructor's (as
   // PreconditionerCache hands out); the multilevel correction reads the lattice through it.
@@ -60,9 +79,29 @@ class RigidParticlePreconditioner {
 
   // The multilevel correction, or null (not asked for, or nothing held).
   const MultilevelCorrection* multilevel() const { return multilevel_.get(); }
+  // Nodes scaled by the inverse of their 3 x 3 block (header).
+  [[nodiscard]] Eigen::Index block_nodes() const {
+    return static_cast<Eigen::Index>(node_blocks_.size());
+  }
 
  private:
-  Eigen::VectorXd inverse_diagonal_;  // D^-1 (only the inverse is kept: 24 bytes per node)
+  // D^-1 (only the inverse is kept: 24 bytes per node); on a block node the diagonal of its
+  // inverse block.
+  Eigen::VectorXd inverse_diagonal_;
+  // A node scaled by its inverse block B^-1: its first dof (its coordinates are dofs first,
+  // first + 1, first + 2) and B^-1's off-diagonal entries.
+  struct NodeBlock {
+    std::int64_t first = 0;
+    double xy = 0.0;
+    double xz = 0.0;
+    double yz = 0.0;
+  };
+  std::vector<NodeBlock> node_blocks_;
+  // Fills node_blocks_ (and their entries of inverse_diagonal_) from the stiffness terms'
+  // diagonal and off-diagonal entries per node (N/m; scaled by `scale`).
+  void invert_node_blocks(const lattice::Lattice& lat, const DofMap& map,
+                          const Eigen::Matrix3Xd& diagonal, const Eigen::Matrix3Xd& off,
+                          double scale);
   double rigid_stiffness_ = 1.0;
   struct Block {
     std::vector<Eigen::Index> dofs;  // 3 n_p, node by node
@@ -79,10 +118,12 @@ class RigidParticlePreconditioner {
 // one, so that two are never held at once (peak memory).
 class PreconditionerCache {
  public:
-  // The preconditioner for these arguments (see above); `processes` as for the constructor.
+  // The preconditioner for these arguments (see above); `processes` and `node_scaling` as for
+  // the constructor.
   std::shared_ptr<const RigidParticlePreconditioner> get(
       const MessSystem& system, const DofMap& map, double force_scale, bool multilevel,
-      const detail::BlockSplit* processes = nullptr);
+      const detail::BlockSplit* processes = nullptr,
+      NodeScaling node_scaling = NodeScaling::blocks);
   int builds() const { return builds_; }
 
  private:
