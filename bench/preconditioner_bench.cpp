@@ -7,7 +7,8 @@
 // run files, every node displaced at random by up to 0.05 l_e (fixed seed) as the state the
 // preconditioner is linearised at, the free coordinates those left by holding all six faces (as
 // the hysteresis runs of Chapter 4 do).
-// Printed with 1 and 2 threads (best of the repeats): the build (the diagonal, the particles'
+// Printed for each node scaling (solver.node_scaling: the nodes' 3 x 3 blocks, the default, and
+// the diagonal) with 1 and 2 threads (best of the repeats): the build (the diagonal, the particles'
 // rigid blocks and the multilevel correction's assembly and coarse factor), one application of
 // the whole preconditioner and of the multilevel correction alone, and the application as
 // nodes per second. Also printed: whether the results with 2 threads are bitwise those with 1,
@@ -39,7 +40,7 @@ struct Measured {
 };
 
 Measured measure(const mess::MessSystem& system, const mess::DofMap& map, double force_scale,
-                 const Eigen::VectorXd& v, int threads, int repeats) {
+                 const Eigen::VectorXd& v, int threads, int repeats, mess::NodeScaling scaling) {
   omp_set_num_threads(threads);
   Measured m;
   std::unique_ptr<mess::RigidParticlePreconditioner> p;
@@ -48,7 +49,7 @@ Measured measure(const mess::MessSystem& system, const mess::DofMap& map, double
   m.build = best_seconds(std::clamp(repeats / 4, 1, 3), [&] {
     p.reset();
     p = std::make_unique<mess::RigidParticlePreconditioner>(system, map, force_scale, true,
-                                                            &system.positions());
+                                                            &system.positions(), nullptr, scaling);
   });
   if (p->multilevel() == nullptr) {
     std::fprintf(stderr, "the multilevel correction was left out (nothing held)\n");
@@ -89,21 +90,25 @@ void run_system(const SystemFile& file, int repeats) {
 
   std::printf("\n%s: %lld nodes, %lld free coordinates\n", file.name, static_cast<long long>(nodes),
               static_cast<long long>(map.size()));
-  Eigen::VectorXd first;
-  for (const int threads : {1, 2}) {
-    const Measured m = measure(system, map, force_scale, v, threads, repeats);
-    std::printf(
-        "  %d thread%s: build %7.3f s; apply P %7.2f ms = %6.1f M nodes/s, of which the multilevel "
-        "correction %7.2f ms; fingerprint of P v %016llx\n",
-        threads, threads == 1 ? " " : "s", m.build, 1e3 * m.apply,
-        1e-6 * static_cast<double>(nodes) / m.apply, 1e3 * m.correction,
-        static_cast<unsigned long long>(
-            mresim::bench::fingerprint(m.applied.data(), m.applied.size())));
-    if (threads == 1) {
-      first = m.applied;
-    } else {
-      std::printf("  P v with 2 threads %s the one with 1 thread\n",
-                  first == m.applied ? "bitwise equals" : "DIFFERS FROM");
+  for (const mess::NodeScaling scaling : {mess::NodeScaling::blocks, mess::NodeScaling::diagonal}) {
+    std::printf("  node scaling \"%s\"\n",
+                scaling == mess::NodeScaling::blocks ? "blocks" : "diagonal");
+    Eigen::VectorXd first;
+    for (const int threads : {1, 2}) {
+      const Measured m = measure(system, map, force_scale, v, threads, repeats, scaling);
+      std::printf(
+          "  %d thread%s: build %7.3f s; apply P %7.2f ms = %6.1f M nodes/s, of which the "
+          "multilevel correction %7.2f ms; fingerprint of P v %016llx\n",
+          threads, threads == 1 ? " " : "s", m.build, 1e3 * m.apply,
+          1e-6 * static_cast<double>(nodes) / m.apply, 1e3 * m.correction,
+          static_cast<unsigned long long>(
+              mresim::bench::fingerprint(m.applied.data(), m.applied.size())));
+      if (threads == 1) {
+        first = m.applied;
+      } else {
+        std::printf("  P v with 2 threads %s the one with 1 thread\n",
+                    first == m.applied ? "bitwise equals" : "DIFFERS FROM");
+      }
     }
   }
   std::fflush(stdout);

@@ -559,9 +559,9 @@ void read_solver(const std::optional<TableReader>& solver, bool demagnetization,
   // Only the minimiser's multilevel preconditioner scales nodes by blocks; the other methods
   // would ignore the choice.
   if (t.has("node_scaling") && s.method != SolverMethod::minimiser) {
-    t.fail("node_scaling", t.value_text("node_scaling"),
-           fmt::format(R"(only read with solver.method = "minimiser" (the method is "{}"))",
-                       method));
+    t.fail(
+        "node_scaling", t.value_text("node_scaling"),
+        fmt::format(R"(only read with solver.method = "minimiser" (the method is "{}"))", method));
   }
   s.node_scaling = t.enumeration_or(
       "node_scaling", mess::NodeScaling::blocks,

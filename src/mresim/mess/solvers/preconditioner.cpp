@@ -12,12 +12,9 @@
 
 namespace mresim::mess {
 
-RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& system,
-                                                         const DofMap& map, double force_scale,
-                                                         bool multilevel,
-                                                         const Eigen::Matrix3Xd* state,
-                                                         const detail::BlockSplit* processes,
-                                                         NodeScaling node_scaling) {
+RigidParticlePreconditioner::RigidParticlePreconditioner(
+    const MessSystem& system, const DofMap& map, double force_scale, bool multilevel,
+    const Eigen::Matrix3Xd* state, const detail::BlockSplit* processes, NodeScaling node_scaling) {
   const lattice::Lattice& lat = system.lattice();
   // Where the particles' rigid motions are taken: the state, or the reference lattice.
   const Eigen::Matrix3Xd& x = state != nullptr ? *state : lat.positions;
@@ -121,11 +118,16 @@ RigidParticlePreconditioner::RigidParticlePreconditioner(const MessSystem& syste
   }
 }
 
-void RigidParticlePreconditioner::invert_node_blocks(const lattice::Lattice& lat,
-                                                     const DofMap& map,
+void RigidParticlePreconditioner::invert_node_blocks(const lattice::Lattice& lat, const DofMap& map,
                                                      const Eigen::Matrix3Xd& diagonal,
                                                      const Eigen::Matrix3Xd& off, double scale) {
-  for (std::int64_t n = 0; n < lat.node_count(); ++n) {
+  // Each node's block is inverted on its own (both threads), then the blocks taken are listed in
+  // node order: the same list for any number of threads.
+  const std::int64_t nodes = lat.node_count();
+  std::vector<NodeBlock> all(static_cast<std::size_t>(nodes));
+  std::vector<char> taken(static_cast<std::size_t>(nodes), 0);
+#pragma omp parallel for schedule(static) if (nodes >= detail::kParallelMinimum)
+  for (std::int64_t n = 0; n < nodes; ++n) {
     if (!lat.particle_of_node.empty() && lat.particle_of_node[static_cast<std::size_t>(n)] >= 0) {
       continue;  // the particles' blocks (their rigid motions) take these dofs
     }
@@ -141,16 +143,20 @@ void RigidParticlePreconditioner::invert_node_blocks(const lattice::Lattice& lat
     b(1, 2) = b(2, 1) = off(2, n);
     b *= scale;
     const Eigen::LLT<Eigen::Matrix3d> factor(b);
-    const Eigen::Vector3d pivots = factor.matrixL().toDenseMatrix().diagonal();
-    if (factor.info() != Eigen::Success || !(pivots.minCoeff() > 0.0) ||
-        pivots.minCoeff() * pivots.minCoeff() < 1e-8 * b.diagonal().maxCoeff()) {
+    const Eigen::Vector3d root_pivots = factor.matrixLLT().diagonal();
+    if (factor.info() != Eigen::Success || !(root_pivots.minCoeff() > 0.0) ||
+        root_pivots.minCoeff() * root_pivots.minCoeff() < 1e-8 * b.diagonal().maxCoeff()) {
       continue;  // not safely positive definite: the diagonal
     }
     const Eigen::Matrix3d inverse = factor.solve(Eigen::Matrix3d::Identity());
     for (int a = 0; a < 3; ++a) inverse_diagonal_[first + a] = inverse(a, a);
-    node_blocks_.push_back({first, 0.5 * (inverse(0, 1) + inverse(1, 0)),
-                            0.5 * (inverse(0, 2) + inverse(2, 0)),
-                            0.5 * (inverse(1, 2) + inverse(2, 1))});
+    all[static_cast<std::size_t>(n)] = {first, 0.5 * (inverse(0, 1) + inverse(1, 0)),
+                                        0.5 * (inverse(0, 2) + inverse(2, 0)),
+                                        0.5 * (inverse(1, 2) + inverse(2, 1))};
+    taken[static_cast<std::size_t>(n)] = 1;
+  }
+  for (std::size_t n = 0; n < all.size(); ++n) {
+    if (taken[n] != 0) node_blocks_.push_back(all[n]);
   }
 }
 
