@@ -78,7 +78,23 @@ RigidParticlePreconditioner::RigidParticlePreconditioner(
   if (blocks) invert_node_blocks(lat, map, d, off, scale);
   rigid_stiffness_ = polymer_count > 0 ? polymer_sum / static_cast<double>(polymer_count) : 1.0;
 
-  // Rigid-motion bases of the particles whose coordinates are all plain free dofs.
+  add_particle_blocks(lat, map, x);
+  if (multilevel) {
+    try {
+      multilevel_ = std::make_unique<MultilevelCorrection>(
+          lat, volume_force_factor, map, force_scale, state,
+          MultilevelCorrection::kDefaultExactLimit, processes);
+    } catch (const std::runtime_error&) {
+      multilevel_.reset();  // nothing held: the coarse Hessian is singular (header)
+    }
+  }
+}
+
+void RigidParticlePreconditioner::add_particle_blocks(const lattice::Lattice& lat,
+                                                      const DofMap& map,
+                                                      const Eigen::Matrix3Xd& x) {
+  const double l_e = lat.element_length;
+  // The particles whose coordinates are all plain free dofs.
   for (const auto& nodes : lat.particle_nodes) {
     Block b;
     bool free = true;
@@ -106,15 +122,6 @@ RigidParticlePreconditioner::RigidParticlePreconditioner(
     b.q = Eigen::HouseholderQR<Eigen::MatrixXd>(r).householderQ() *
           Eigen::MatrixXd::Identity(3 * np, 6);
     blocks_.push_back(std::move(b));
-  }
-  if (multilevel) {
-    try {
-      multilevel_ = std::make_unique<MultilevelCorrection>(
-          lat, volume_force_factor, map, force_scale, state,
-          MultilevelCorrection::kDefaultExactLimit, processes);
-    } catch (const std::runtime_error&) {
-      multilevel_.reset();  // nothing held: the coarse Hessian is singular (header)
-    }
   }
 }
 

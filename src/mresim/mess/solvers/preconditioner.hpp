@@ -97,6 +97,9 @@ class RigidParticlePreconditioner {
     double yz = 0.0;
   };
   std::vector<NodeBlock> node_blocks_;
+  // Fills blocks_: the rigid-motion bases of the particles at positions x (3 x N, m).
+  void add_particle_blocks(const lattice::Lattice& lat, const DofMap& map,
+                           const Eigen::Matrix3Xd& x);
   // Fills node_blocks_ (and their entries of inverse_diagonal_) from the stiffness terms'
   // diagonal and off-diagonal entries per node (N/m; scaled by `scale`).
   void invert_node_blocks(const lattice::Lattice& lat, const DofMap& map,
