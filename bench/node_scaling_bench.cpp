@@ -21,86 +21,37 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <ctime>
-#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "mresim/config/table_reader.hpp"
 #include "mresim/mess/protocols/protocol_runner.hpp"
-#include "mresim/mess/run_file/mess_spec.hpp"
+#include "protocol_bench_options.hpp"
 
 namespace {
 
 namespace mp = mresim::mess_protocol;
 
-double cpu_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
-struct Run {
-  std::vector<mp::StepRecord> records;
-  double cpu = std::numeric_limits<double>::infinity();  // s, all steps
-  std::int64_t iterations = 0;
-  std::int64_t evaluations = 0;
-  std::int64_t nodes = 0;
-};
+using Run = mresim::bench::ProtocolRun;
 
 Run run(const std::string& scaling, int order, int steps) {
-  const std::string path =
-      std::string(MRESIM_SOURCE_DIR) + "/examples/chapter4/fig4_11_pair_large_box_S6_5um.toml";
-  const std::vector<std::string> overrides = {fmt::format("model.discretization_order={}", order),
-                                              fmt::format("field.max={}", 0.005 * steps),
-                                              fmt::format("field.steps={}", steps),
-                                              "field.sequence=\"up\"",
-                                              "output.node_positions=false",
-                                              "output.checkpoint_every=0",
-                                              fmt::format("solver.node_scaling=\"{}\"", scaling)};
-  const mresim::mess_config::MessSpec spec = mresim::mess_config::read_mess_run_file(
-      mresim::config::TableReader::parse_file(path, overrides));
-  mp::ProtocolRunner runner(spec);
-  mp::ProtocolState state = runner.initial_state();
-  Run r;
-  r.nodes = runner.system().node_count();
-  const double cpu0 = cpu_seconds();
-  while (state.next_step < runner.steps().size()) {
-    const mp::StepRecord& record = runner.run_next_step(state);
-    r.iterations += record.iterations;
-    r.evaluations += record.evaluations;
-    if (!record.converged) {
-      std::fprintf(stderr, "%s: step %zu did not converge (%s)\n", scaling.c_str(),
-                   record.step.index, record.status.c_str());
-      std::exit(1);
-    }
-  }
-  r.cpu = cpu_seconds() - cpu0;
-  r.records = state.records;
-  return r;
-}
-
-int read_option(int argc, char** argv, const std::string& key, int fallback) {
-  for (int k = 1; k + 1 < argc; ++k) {
-    if (argv[k] == key) return std::max(1, std::atoi(argv[k + 1]));
-  }
-  return fallback;
+  return mresim::bench::run_protocol(
+      "examples/chapter4/fig4_11_pair_large_box_S6_5um.toml",
+      {fmt::format("model.discretization_order={}", order),
+       fmt::format("field.max={}", 0.005 * steps), fmt::format("field.steps={}", steps),
+       "field.sequence=\"up\"", "output.node_positions=false", "output.checkpoint_every=0",
+       fmt::format("solver.node_scaling=\"{}\"", scaling)},
+      scaling, [](const mp::StepRecord&) { return true; });
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  for (int k = 1; k < argc; k += 2) {
-    const std::string key = argv[k];
-    if ((key != "--order" && key != "--steps" && key != "--repeats") || k + 1 >= argc) {
-      std::fprintf(stderr, "unknown option %s (--order N, --steps K, --repeats R)\n", argv[k]);
-      return 2;
-    }
-  }
-  const int order = read_option(argc, argv, "--order", 3);
-  const int steps = read_option(argc, argv, "--steps", 7);
-  const int repeats = read_option(argc, argv, "--repeats", 1);
+  const auto options = mresim::bench::parse_protocol_bench_options(argc, argv, 3, 7);
+  if (!options) return 2;
+  const int order = options->order;
+  const int steps = options->steps;
+  const int repeats = options->repeats;
   double load[3] = {};
   if (getloadavg(load, 3) > 0) std::printf("load average at start: %.2f\n", load[0]);
 

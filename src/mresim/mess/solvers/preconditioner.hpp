@@ -31,8 +31,9 @@
 // inverse of that block's diagonal (NodeScaling::blocks, the default). In contact the polymer
 // between the particles is compressed and sheared, so a node's stiffness is strongly
 // anisotropic with principal directions off the lattice axes, which a diagonal cannot describe:
-// on four steps of the full-size Fig. 4.11 loop the blocks took 14-21 % fewer L-BFGS iterations
-// (docs/performance.md, "Node blocks in the multilevel preconditioner"). Each block is a sum of
+// on four steps of the full-size Fig. 4.11 loop the blocks took 12-21 % fewer L-BFGS iterations,
+// 9 % fewer over the whole loop (docs/performance.md, "Node blocks in the multilevel
+// preconditioner"). Each block is a sum of
 // positive semi-definite terms; one that is not safely positive definite (its Cholesky factor's
 // smallest pivot below 1e-8 of its largest diagonal entry) keeps its diagonal. So P stays
 // symmetric positive definite. The blocks' off-diagonal entries cost 32 bytes per node (the
