@@ -1,19 +1,22 @@
-// How the multilevel preconditioner scales the polymer's nodes (solver.node_scaling,
-// solvers/preconditioner.hpp "Node blocks"): the inverse of each node's 3 x 3 stiffness block
-// ("blocks", the default) against the inverse of its diagonal ("diagonal", the scaling before),
-// in one run. Problem: the Fig. 4.11 pair's full box (the example's run file) at a lower
-// discretization order, fields 0, 5, ..., 35 mT upwards: the pair snaps into contact on the way
-// (seed profile; 79,054 nodes at the default n_d = 3, where the default minimiser uses the
-// multilevel preconditioner). Prints per step the iterations with each scaling, then the totals,
-// the evaluations, the CPU time, the ratios, and how far apart the two runs' states are (per step:
-// the largest difference of a centre coordinate and of M, the total energy's relative one). Exit
-// status 1 if a step does not converge or the two scalings take identical paths (the setting
-// would not have reached the preconditioner).
+// Two choices of the multilevel preconditioner's finest level, in one run (solvers/
+// preconditioner.hpp): how it scales the polymer's nodes (solver.node_scaling: the inverse of
+// each node's 3 x 3 stiffness block, "blocks", the default, against the inverse of its diagonal,
+// "diagonal", the scaling before), or with --compare contact_gap whether it solves the polymer
+// between particles in contact exactly (solver.contact_gap: "exact", the default, against
+// "none", the preconditioner before; solvers/contact_gap_blocks.hpp). Problem: the Fig. 4.11
+// pair's full box (the example's run file) at a lower discretization order, fields 0, 5, ..., 35
+// mT upwards: the pair snaps into contact on the way (seed profile; 79,054 nodes at the default
+// n_d = 3, where the default minimiser uses the multilevel preconditioner). Prints per step the
+// iterations with each choice, then the totals, the evaluations, the CPU time, the ratios, and
+// how far apart the two runs' states are (per step: the largest difference of a centre
+// coordinate and of M, the total energy's relative one). Exit status 1 if a step does not
+// converge or the two choices take identical paths (the setting would not have reached the
+// preconditioner).
 //
-//   ./build/node_scaling_bench [--order N] [--steps K] [--repeats R]
+//   ./build/node_scaling_bench [--order N] [--steps K] [--repeats R] [--compare contact_gap]
 //
 // --order: the discretization order n_d (default 3); --steps: field steps after 0 mT, 5 mT
-// apart (default 7); --repeats: runs of each scaling, alternating, the fastest CPU time kept
+// apart (default 7); --repeats: runs of each choice, alternating, the fastest CPU time kept
 // (default 1). One thread per run unless OMP_NUM_THREADS says otherwise.
 #include <fmt/format.h>
 
@@ -34,20 +37,40 @@ namespace mp = mresim::mess_protocol;
 
 using Run = mresim::bench::ProtocolRun;
 
-Run run(const std::string& scaling, int order, int steps) {
+// solver.<key> = value.
+Run run(const std::string& key, const std::string& value, int order, int steps) {
   return mresim::bench::run_protocol(
       "examples/chapter4/fig4_11_pair_large_box_S6_5um.toml",
       {fmt::format("model.discretization_order={}", order),
        fmt::format("field.max={}", 0.005 * steps), fmt::format("field.steps={}", steps),
        "field.sequence=\"up\"", "output.node_positions=false", "output.checkpoint_every=0",
-       fmt::format("solver.node_scaling=\"{}\"", scaling)},
-      scaling, [](const mp::StepRecord&) { return true; });
+       fmt::format("solver.{}=\"{}\"", key, value)},
+      value, [](const mp::StepRecord&) { return true; });
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const auto options = mresim::bench::parse_protocol_bench_options(argc, argv, 3, 7);
+  // --compare contact_gap switches the setting; the rest are the protocol benches' options.
+  std::string key = "node_scaling";
+  std::vector<char*> rest = {argv[0]};
+  for (int k = 1; k < argc; ++k) {
+    if (std::string(argv[k]) == "--compare" && k + 1 < argc) {
+      key = argv[++k];
+    } else {
+      rest.push_back(argv[k]);
+    }
+  }
+  if (key != "node_scaling" && key != "contact_gap") {
+    std::fprintf(stderr, "--compare %s: one of node_scaling, contact_gap\n", key.c_str());
+    return 2;
+  }
+  // The earlier choice first, then the default.
+  const std::pair<std::string, std::string> values =
+      key == "node_scaling" ? std::pair<std::string, std::string>{"diagonal", "blocks"}
+                            : std::pair<std::string, std::string>{"none", "exact"};
+  const auto options =
+      mresim::bench::parse_protocol_bench_options(static_cast<int>(rest.size()), rest.data(), 3, 7);
   if (!options) return 2;
   const int order = options->order;
   const int steps = options->steps;
@@ -55,19 +78,21 @@ int main(int argc, char** argv) {
   double load[3] = {};
   if (getloadavg(load, 3) > 0) std::printf("load average at start: %.2f\n", load[0]);
 
-  Run diagonal;
-  Run blocks;
+  Run earlier;  // the choice before (values.first)
+  Run chosen;   // the default (values.second)
   for (int k = 0; k < repeats; ++k) {
-    Run a = run("diagonal", order, steps);
-    Run b = run("blocks", order, steps);
-    if (a.cpu < diagonal.cpu) diagonal = std::move(a);
-    if (b.cpu < blocks.cpu) blocks = std::move(b);
+    Run a = run(key, values.first, order, steps);
+    Run b = run(key, values.second, order, steps);
+    if (a.cpu < earlier.cpu) earlier = std::move(a);
+    if (b.cpu < chosen.cpu) chosen = std::move(b);
   }
   std::printf("Fig. 4.11 pair, full box, n_d = %d: %lld nodes, fields 0 ... %g mT upwards\n", order,
-              static_cast<long long>(diagonal.nodes), 5.0 * steps);
-  std::printf("  %4s %10s %9s %9s %28s %20s %12s %12s %12s\n", "step", "field (mT)", "diagonal",
-              "blocks", "separation (um), diag/blocks", "pair angle (deg)", "centres (m)",
-              "M (A/m)", "energy");
+              static_cast<long long>(earlier.nodes), 5.0 * steps);
+  std::printf("solver.%s: %s against %s\n", key.c_str(), values.first.c_str(),
+              values.second.c_str());
+  std::printf("  %4s %10s %9s %9s %28s %20s %12s %12s %12s\n", "step", "field (mT)",
+              values.first.c_str(), values.second.c_str(), "separation (um), each",
+              "pair angle (deg)", "centres (m)", "M (A/m)", "energy");
   // The pair axis's angle from the field's axis (z).
   const auto angle = [](const mp::StepRecord& r) {
     const Eigen::Vector3d d = r.centres.col(1) - r.centres.col(0);
@@ -76,9 +101,9 @@ int main(int argc, char** argv) {
   const auto separation = [](const mp::StepRecord& r) {
     return 1e6 * (r.centres.col(1) - r.centres.col(0)).norm();
   };
-  for (std::size_t i = 0; i < diagonal.records.size(); ++i) {
-    const mp::StepRecord& a = diagonal.records[i];
-    const mp::StepRecord& b = blocks.records[i];
+  for (std::size_t i = 0; i < earlier.records.size(); ++i) {
+    const mp::StepRecord& a = earlier.records[i];
+    const mp::StepRecord& b = chosen.records[i];
     const double total = std::abs(a.energies.total());
     std::printf("  %4zu %10.1f %9lld %9lld %13.5f / %.5f %9.4f / %.4f %12.2e %12.2e %12.2e\n", i,
                 1e3 * a.step.field.norm(), static_cast<long long>(a.iterations),
@@ -87,24 +112,25 @@ int main(int argc, char** argv) {
                 (a.magnetization - b.magnetization).cwiseAbs().maxCoeff(),
                 total > 0.0 ? std::abs(a.energies.total() - b.energies.total()) / total : 0.0);
   }
-  for (const auto& [name, r] :
-       {std::pair<const char*, const Run&>{"diagonal", diagonal}, {"blocks", blocks}}) {
-    std::printf("  %-9s %6lld iterations, %6lld evaluations, CPU %8.2f s\n", name,
+  for (const auto& [name, r] : {std::pair<const std::string&, const Run&>{values.first, earlier},
+                                {values.second, chosen}}) {
+    std::printf("  %-9s %6lld iterations, %6lld evaluations, CPU %8.2f s\n", name.c_str(),
                 static_cast<long long>(r.iterations), static_cast<long long>(r.evaluations), r.cpu);
   }
-  std::printf("  diagonal / blocks: iterations %.2fx, evaluations %.2fx, CPU %.2fx\n",
-              static_cast<double>(diagonal.iterations) / static_cast<double>(blocks.iterations),
-              static_cast<double>(diagonal.evaluations) / static_cast<double>(blocks.evaluations),
-              diagonal.cpu / blocks.cpu);
+  std::printf("  %s / %s: iterations %.2fx, evaluations %.2fx, CPU %.2fx\n", values.first.c_str(),
+              values.second.c_str(),
+              static_cast<double>(earlier.iterations) / static_cast<double>(chosen.iterations),
+              static_cast<double>(earlier.evaluations) / static_cast<double>(chosen.evaluations),
+              earlier.cpu / chosen.cpu);
 
   double centres = 0.0;
   double separations = 0.0;
   double magnetization = 0.0;
   double energy = 0.0;
   bool identical = true;
-  for (std::size_t i = 0; i < diagonal.records.size(); ++i) {
-    const mp::StepRecord& a = diagonal.records[i];
-    const mp::StepRecord& b = blocks.records[i];
+  for (std::size_t i = 0; i < earlier.records.size(); ++i) {
+    const mp::StepRecord& a = earlier.records[i];
+    const mp::StepRecord& b = chosen.records[i];
     centres = std::max(centres, (a.centres - b.centres).cwiseAbs().maxCoeff());
     separations = std::max(separations, std::abs(separation(a) - separation(b)) * 1e-6);
     magnetization =
@@ -120,7 +146,7 @@ int main(int argc, char** argv) {
       "relative\n",
       centres, separations, magnetization, energy);
   if (identical) {
-    std::fprintf(stderr, "the two scalings took identical paths: the setting had no effect\n");
+    std::fprintf(stderr, "the two choices took identical paths: the setting had no effect\n");
     return 1;
   }
   return 0;

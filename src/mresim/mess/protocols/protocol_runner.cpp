@@ -101,6 +101,7 @@ mess::MinimiserOptions ProtocolRunner::minimiser_options() const {
                                      : mess::LbfgsPreconditioner::rigid_particles;
   options.preconditioner_cache = preconditioner_cache_;  // one for the run's steps
   options.node_scaling = spec_.solver.node_scaling;
+  options.contact_gap = spec_.solver.contact_gap;
   options.force_tolerance = spec_.solver.minimiser.force_tolerance;
   options.max_iterations = static_cast<int>(spec_.solver.minimiser.max_iterations);
   options.observer = observer_;

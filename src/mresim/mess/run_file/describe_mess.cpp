@@ -253,6 +253,12 @@ void describe_solver(const MessSpec& s, app::InfoReport& r) {
                           "stiffness block"
                         : "the multilevel preconditioner inverts each node's diagonal (before "
                           "the blocks)");
+      const bool gap = v.contact_gap == mess::ContactGap::exact;
+      r.add_text(sec, "contact_gap", gap ? "exact" : "none",
+                 gap ? "the multilevel preconditioner solves the polymer between particles in "
+                       "contact exactly"
+                     : "the polymer between particles in contact is left to the node scaling "
+                       "(before the gap blocks)");
     }
   } else {
     const lattice::LatticeSpec& l = s.lattice;

@@ -31,6 +31,7 @@
 #include "mresim/mess/magnetization/magnetic_particles.hpp"
 #include "mresim/mess/magnetization/self_consistent.hpp"
 #include "mresim/mess/profile/model_profile.hpp"
+#include "mresim/mess/solvers/contact_gap.hpp"
 #include "mresim/mess/solvers/node_scaling.hpp"
 #include "mresim/mess/terms/energy_term.hpp"
 #include "mresim/mess/terms/magnetic_energy.hpp"
@@ -188,6 +189,9 @@ struct SolverSpec {
   // method = "minimiser" only: how its multilevel preconditioner (from 40,000 nodes) scales the
   // polymer's nodes (solvers/node_scaling.hpp).
   mess::NodeScaling node_scaling = mess::NodeScaling::blocks;
+  // method = "minimiser" only: whether that preconditioner solves the polymer between particles
+  // in contact exactly (solvers/contact_gap_blocks.hpp).
+  mess::ContactGap contact_gap = mess::ContactGap::exact;
   MinimiserSettings minimiser;
   LeapfrogSettings leapfrog;
   // atol, rtol, iteration budgets; `demagnetization` mirrors MessSpec::demagnetization.

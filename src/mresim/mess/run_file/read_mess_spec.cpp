@@ -556,16 +556,21 @@ void read_solver(const std::optional<TableReader>& solver, bool demagnetization,
       "field_step_start",
       s.method == SolverMethod::leapfrog ? FieldStepStart::previous : FieldStepStart::extrapolated,
       {{"extrapolated", FieldStepStart::extrapolated}, {"previous", FieldStepStart::previous}});
-  // Only the minimiser's multilevel preconditioner scales nodes by blocks; the other methods
-  // would ignore the choice.
-  if (t.has("node_scaling") && s.method != SolverMethod::minimiser) {
-    t.fail(
-        "node_scaling", t.value_text("node_scaling"),
-        fmt::format(R"(only read with solver.method = "minimiser" (the method is "{}"))", method));
+  // Only the minimiser's multilevel preconditioner scales nodes by blocks and solves the gaps
+  // between particles in contact; the other methods would ignore the choices.
+  for (const char* key : {"node_scaling", "contact_gap"}) {
+    if (t.has(key) && s.method != SolverMethod::minimiser) {
+      t.fail(key, t.value_text(key),
+             fmt::format(R"(only read with solver.method = "minimiser" (the method is "{}"))",
+                         method));
+    }
   }
   s.node_scaling = t.enumeration_or(
       "node_scaling", mess::NodeScaling::blocks,
       {{"blocks", mess::NodeScaling::blocks}, {"diagonal", mess::NodeScaling::diagonal}});
+  s.contact_gap =
+      t.enumeration_or("contact_gap", mess::ContactGap::exact,
+                       {{"exact", mess::ContactGap::exact}, {"none", mess::ContactGap::none}});
   // [solver.minimiser] holds the criteria of lbfgs and newton alike.
   const std::string other = method == "leapfrog" ? "minimiser" : "leapfrog";
   if (t.has(other)) {

@@ -325,11 +325,11 @@ class Minimisation {
       preconditioner_ =
           options.preconditioner_cache != nullptr
               ? options.preconditioner_cache->get(system, map, force_scale, multilevel, processes,
-                                                  options.node_scaling)
+                                                  options.node_scaling, options.contact_gap)
               : std::make_shared<const RigidParticlePreconditioner>(
                     system, map, force_scale, multilevel,
                     multilevel ? &system.positions() : nullptr,  // as the cache builds it
-                    processes, options.node_scaling);
+                    processes, options.node_scaling, options.contact_gap);
     }
     const bool single = options.lbfgs_history == LbfgsHistoryPrecision::single_precision ||
                         (options.lbfgs_history == LbfgsHistoryPrecision::automatic && multilevel);

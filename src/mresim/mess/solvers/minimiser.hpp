@@ -60,6 +60,7 @@
 #include <string>
 
 #include "mresim/mess/solvers/amg_preconditioner.hpp"
+#include "mresim/mess/solvers/contact_gap.hpp"
 #include "mresim/mess/solvers/node_scaling.hpp"
 #include "mresim/mess/solvers/relaxation_observer.hpp"
 #include "mresim/mess/system/system_energy.hpp"
@@ -151,6 +152,9 @@ struct MinimiserOptions {
   // inverse of each node's 3 x 3 stiffness block, or of its diagonal); the rigid-particle
   // preconditioner alone, built at rest, has the diagonal either way.
   NodeScaling node_scaling = NodeScaling::blocks;
+  // Whether the multilevel preconditioner solves the polymer between particles in contact
+  // exactly (contact_gap_blocks.hpp).
+  ContactGap contact_gap = ContactGap::exact;
   // multilevel and rigid_particles: where the preconditioner is kept between calls (a caller
   // relaxing many steps of one system keeps one; null: built anew in every call).
   std::shared_ptr<PreconditionerCache> preconditioner_cache;

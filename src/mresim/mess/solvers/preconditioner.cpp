@@ -14,7 +14,8 @@ namespace mresim::mess {
 
 RigidParticlePreconditioner::RigidParticlePreconditioner(
     const MessSystem& system, const DofMap& map, double force_scale, bool multilevel,
-    const Eigen::Matrix3Xd* state, const detail::BlockSplit* processes, NodeScaling node_scaling) {
+    const Eigen::Matrix3Xd* state, const detail::BlockSplit* processes, NodeScaling node_scaling,
+    ContactGap contact_gap) {
   const lattice::Lattice& lat = system.lattice();
   // Where the particles' rigid motions are taken: the state, or the reference lattice.
   const Eigen::Matrix3Xd& x = state != nullptr ? *state : lat.positions;
@@ -79,6 +80,10 @@ RigidParticlePreconditioner::RigidParticlePreconditioner(
   rigid_stiffness_ = polymer_count > 0 ? polymer_sum / static_cast<double>(polymer_count) : 1.0;
 
   add_particle_blocks(lat, map, x);
+  if (state != nullptr && contact_gap == ContactGap::exact) {
+    auto gaps = std::make_unique<ContactGapBlocks>(system, map, force_scale);
+    if (gaps->gaps() > 0) contact_gaps_ = std::move(gaps);
+  }
   if (multilevel) {
     try {
       multilevel_ = std::make_unique<MultilevelCorrection>(
@@ -196,6 +201,7 @@ Eigen::VectorXd RigidParticlePreconditioner::apply(const DofMap& map,
     for (Eigen::Index i = 0; i < m; ++i) w[b.dofs[static_cast<std::size_t>(i)]] = wp[i];
   }
   if (multilevel_ != nullptr) multilevel_->add_to(map, v, w);
+  if (contact_gaps_ != nullptr) contact_gaps_->add_to(v, w);
   return w;
 }
 
@@ -237,12 +243,12 @@ std::uint64_t preconditioner_key(const MessSystem& system, const DofMap& map, do
 
 std::shared_ptr<const RigidParticlePreconditioner> PreconditionerCache::get(
     const MessSystem& system, const DofMap& map, double force_scale, bool multilevel,
-    const detail::BlockSplit* processes, NodeScaling node_scaling) {
+    const detail::BlockSplit* processes, NodeScaling node_scaling, ContactGap contact_gap) {
   const std::uint64_t key = preconditioner_key(system, map, force_scale, multilevel);
   if (multilevel) {
     kept_.reset();  // before the new one is built: never two at once
     kept_ = std::make_shared<const RigidParticlePreconditioner>(
-        system, map, force_scale, true, &system.positions(), processes, node_scaling);
+        system, map, force_scale, true, &system.positions(), processes, node_scaling, contact_gap);
     lattice_ = &system.lattice();
     key_ = key;
     ++builds_;

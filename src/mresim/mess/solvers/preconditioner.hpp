@@ -53,6 +53,8 @@
 #include <memory>
 #include <vector>
 
+#include "mresim/mess/solvers/contact_gap.hpp"
+#include "mresim/mess/solvers/contact_gap_blocks.hpp"
 #include "mresim/mess/solvers/multilevel_correction.hpp"
 #include "mresim/mess/solvers/node_scaling.hpp"
 #include "mresim/mess/system/constraints.hpp"
@@ -68,11 +70,14 @@ class RigidParticlePreconditioner {
   // (stiffness_terms.hpp) and the particles' rigid motions taken; null: the reference lattice.
   // `processes`: the MPI processes that share the multilevel correction's build
   // (multilevel_correction.hpp; collective on them), null: this process alone.
-  // `node_scaling`: used where `state` is given (header).
+  // `node_scaling`: used where `state` is given (header). `contact_gap`: where `state` is given,
+  // whether the polymer between particles in contact is solved exactly (contact_gap_blocks.hpp:
+  // the gaps of the system's current positions, where the minimisers build P).
   RigidParticlePreconditioner(const MessSystem& system, const DofMap& map, double force_scale,
                               bool multilevel = false, const Eigen::Matrix3Xd* state = nullptr,
                               const detail::BlockSplit* processes = nullptr,
-                              NodeScaling node_scaling = NodeScaling::blocks);
+                              NodeScaling node_scaling = NodeScaling::blocks,
+                              ContactGap contact_gap = ContactGap::exact);
 
   // P v. `map`: one with the same free coordinates and groups as the constructor's (as
   // PreconditionerCache hands out); the multilevel correction reads the lattice through it.
@@ -80,6 +85,8 @@ class RigidParticlePreconditioner {
 
   // The multilevel correction, or null (not asked for, or nothing held).
   const MultilevelCorrection* multilevel() const { return multilevel_.get(); }
+  // The gaps between particles in contact solved exactly, or null (none, or not asked for).
+  const ContactGapBlocks* contact_gaps() const { return contact_gaps_.get(); }
   // Nodes scaled by the inverse of their 3 x 3 block (header).
   [[nodiscard]] Eigen::Index block_nodes() const {
     return static_cast<Eigen::Index>(node_blocks_.size());
@@ -113,6 +120,7 @@ class RigidParticlePreconditioner {
   };
   std::vector<Block> blocks_;
   std::unique_ptr<MultilevelCorrection> multilevel_;
+  std::unique_ptr<ContactGapBlocks> contact_gaps_;
 };
 
 // A run's preconditioner, kept across its relaxations. Without the multilevel correction it is
@@ -122,12 +130,12 @@ class RigidParticlePreconditioner {
 // one, so that two are never held at once (peak memory).
 class PreconditionerCache {
  public:
-  // The preconditioner for these arguments (see above); `processes` and `node_scaling` as for
-  // the constructor.
+  // The preconditioner for these arguments (see above); `processes`, `node_scaling` and
+  // `contact_gap` as for the constructor.
   std::shared_ptr<const RigidParticlePreconditioner> get(
       const MessSystem& system, const DofMap& map, double force_scale, bool multilevel,
-      const detail::BlockSplit* processes = nullptr,
-      NodeScaling node_scaling = NodeScaling::blocks);
+      const detail::BlockSplit* processes = nullptr, NodeScaling node_scaling = NodeScaling::blocks,
+      ContactGap contact_gap = ContactGap::exact);
   int builds() const { return builds_; }
 
  private:

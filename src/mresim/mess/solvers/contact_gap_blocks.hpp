@@ -1,0 +1,81 @@
+#pragma once
+
+// The polymer between two particles in contact, solved exactly in the minimisers' multilevel
+// preconditioner (preconditioner.hpp): P + sum_g R_g^T H_g^-1 R_g, with R_g the free
+// coordinates of gap g's polymer nodes and H_g their block of the exact elastic Hessian (springs
+// and cells, eqs. 4.62 and 4.64, with their force factors) at the state the preconditioner is
+// built at.
+//
+// Why. Between two particles in contact the polymer is squeezed into a gap of about one lattice
+// spacing, and its compressed springs (whose Hessian k (1 - L/l) (I - u u^T) is negative) make
+// its shear and buckling modes soft. Those are the slowest modes of the preconditioned Hessian:
+// on the Fig. 4.11 pair in contact at n_d = 3 the three smallest Ritz values of P H (about
+// 5e-4 of the largest) had 44-78 % of their weight in a disc of polymer about the pair's
+// midpoint, 0.4 % of the box (bench/preconditioned_spectrum_bench.cpp). The diagonal or node
+// blocks cannot describe them, and the coarse levels, built from the positive stiffness terms,
+// do not see them. Solving the gap exactly takes them out: conjugate gradients on P H needed
+// 1.65x fewer iterations for six decades there, and L-BFGS 2.2-2.4x fewer on single full-size
+// steps in contact (docs/performance.md, "The polymer between particles in contact").
+//
+// Where. The gaps are found, and their blocks taken, at the system's current positions: where
+// the minimisers build the preconditioner (the state it is built at).
+//
+// Which gaps. A pair of particles whose centres (the mean of their nodes) are less than
+// kContactSeparation radii apart, i.e. less than one radius of polymer between their surfaces.
+// Its gap: the polymer nodes with all three coordinates free dofs of their own that lie within
+// kGapHalfLength radii of the pair's midpoint along its axis and within kGapRadius radii of the
+// axis. On the full-size Fig. 4.11 lattice (R = 5.5 l_e) that is about 2,000 nodes. A gap whose
+// block is not positive definite (its sparse Cholesky factor fails) is left out, so P stays
+// symmetric positive definite.
+//
+// Cost. The block is assembled from one sweep of the system's elastic Hessian blocks per gap
+// (serial; only where a pair is in contact), and factored with a sparse Cholesky factor (Eigen's
+// SimplicialLLT, AMD ordering). Applying it is two triangular solves per gap, serial, so the
+// result does not depend on the number of threads.
+
+#include <Eigen/Core>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "mresim/mess/system/constraints.hpp"
+#include "mresim/mess/system/system_energy.hpp"
+
+namespace mresim::mess {
+
+class ContactGapBlocks {
+ public:
+  static constexpr double kContactSeparation = 3.0;  // centre distance, particle radii
+  static constexpr double kGapHalfLength = 1.0;      // along the pair's axis, radii
+  static constexpr double kGapRadius = 5.0 / 3.0;    // from the axis, radii
+
+  // The gaps of the system at its current positions, scaled like the preconditioner's variables
+  // (H l_e / force_scale). `map`: the minimiser's.
+  ContactGapBlocks(const MessSystem& system, const DofMap& map, double force_scale);
+
+  // w += sum_g R_g^T H_g^-1 R_g v (v, w over the map's dofs).
+  void add_to(const Eigen::VectorXd& v, Eigen::VectorXd& w) const;
+
+  // Gaps solved exactly, and the dofs they hold in all.
+  [[nodiscard]] std::size_t gaps() const { return gaps_.size(); }
+  [[nodiscard]] Eigen::Index dofs() const;
+  // Gaps found but left out (their block not positive definite).
+  [[nodiscard]] int left_out() const { return left_out_; }
+
+ private:
+  struct Gap {
+    std::vector<Eigen::Index> dofs;  // the map's dof of each local coordinate
+    std::unique_ptr<Eigen::SimplicialLLT<Eigen::SparseMatrix<double>>> factor;
+  };
+  // The polymer nodes of the gap between particles centred at `first` and `second` (header).
+  static std::vector<std::int64_t> gap_nodes(const MessSystem& system, const DofMap& map,
+                                             const Eigen::Vector3d& first,
+                                             const Eigen::Vector3d& second);
+  std::vector<Gap> gaps_;
+  int left_out_ = 0;
+};
+
+}  // namespace mresim::mess
