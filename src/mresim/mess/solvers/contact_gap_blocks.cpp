@@ -25,9 +25,11 @@ class GapSink final : public HessianBlockSink {
     if (li < 0 || local_[static_cast<std::size_t>(j)] < 0) return;
     blocks_[27 * static_cast<std::size_t>(li) + neighbour_code(i, j)] += scale_ * block;
   }
-  // The gap's block of the Hessian: row and column 3 k + a for the k-th gap node.
-  [[nodiscard]] Eigen::SparseMatrix<double> matrix(const std::vector<std::int64_t>& nodes) const {
-    std::vector<Eigen::Triplet<double>> entries;
+  // The lower triangle of the gap's block of the Hessian, in single precision (all the factor
+  // reads): row and column 3 k + a for the k-th gap node.
+  [[nodiscard]] Eigen::SparseMatrix<float> lower_matrix(
+      const std::vector<std::int64_t>& nodes) const {
+    std::vector<Eigen::Triplet<float>> entries;
     for (std::size_t k = 0; k < nodes.size(); ++k) {
       const std::array<int, 3> at = shape_.node_coordinates(static_cast<int>(nodes[k]));
       for (std::size_t code = 0; code < 27; ++code) {
@@ -39,13 +41,15 @@ class GapSink final : public HessianBlockSink {
         const std::int32_t lj = local_[static_cast<std::size_t>(j)];
         for (int c = 0; c < 3; ++c) {
           for (int r = 0; r < 3; ++r) {
-            entries.emplace_back(3 * static_cast<int>(k) + r, 3 * lj + c, b(r, c));
+            const int row = 3 * static_cast<int>(k) + r;
+            const int column = 3 * lj + c;
+            if (row >= column) entries.emplace_back(row, column, static_cast<float>(b(r, c)));
           }
         }
       }
     }
     const auto size = static_cast<Eigen::Index>(3 * nodes.size());
-    Eigen::SparseMatrix<double> m(size, size);
+    Eigen::SparseMatrix<float> m(size, size);
     m.setFromTriplets(entries.begin(), entries.end());
     return m;
   }
@@ -109,14 +113,13 @@ ContactGapBlocks::ContactGapBlocks(const MessSystem& system, const DofMap& map,
         local[static_cast<std::size_t>(nodes[k])] = static_cast<std::int32_t>(k);
         for (int a = 0; a < 3; ++a) gap.dofs.push_back(map.own_dof_of_coordinate(3 * nodes[k] + a));
       }
-      Eigen::SparseMatrix<double> block;
+      Eigen::SparseMatrix<float> lower;
       {
         GapSink sink(lat.shape, local, nodes.size(), scale);
         system.add_elastic_hessian_blocks(sink);
-        block = sink.matrix(nodes);
+        lower = sink.lower_matrix(nodes);
       }
-      gap.factor = std::make_unique<Eigen::SimplicialLLT<Eigen::SparseMatrix<float>>>(
-          Eigen::SparseMatrix<float>(block.cast<float>()));
+      gap.factor = std::make_unique<Eigen::SimplicialLLT<Eigen::SparseMatrix<float>>>(lower);
       if (gap.factor->info() != Eigen::Success) {
         ++left_out_;  // not positive definite (header)
         continue;
