@@ -59,8 +59,8 @@ class GapSink final : public HessianBlockSink {
   [[nodiscard]] std::size_t neighbour_code(std::int64_t i, std::int64_t j) const {
     const std::array<int, 3> a = shape_.node_coordinates(static_cast<int>(i));
     const std::array<int, 3> b = shape_.node_coordinates(static_cast<int>(j));
-    return static_cast<std::size_t>((b[0] - a[0] + 1) + 3 * (b[1] - a[1] + 1) +
-                                    9 * (b[2] - a[2] + 1));
+    const int code = (b[0] - a[0] + 1) + 3 * (b[1] - a[1] + 1) + 9 * (b[2] - a[2] + 1);
+    return static_cast<std::size_t>(code);
   }
   const lattice::GridShape& shape_;
   const std::vector<std::int32_t>& local_;
