@@ -3,17 +3,21 @@
 // each node's 3 x 3 stiffness block, "blocks", the default, against the inverse of its diagonal,
 // "diagonal", the scaling before), or with --compare contact_gap whether it solves the polymer
 // between particles in contact exactly (solver.contact_gap: "exact", the default, against
-// "none", the preconditioner before; solvers/contact_gap_blocks.hpp). Problem: the Fig. 4.11
-// pair's full box (the example's run file) at a lower discretization order, fields 0, 5, ..., 35
-// mT upwards: the pair snaps into contact on the way (seed profile; 79,054 nodes at the default
-// n_d = 3, where the default minimiser uses the multilevel preconditioner). Prints per step the
-// iterations with each choice, then the totals, the evaluations, the CPU time, the ratios, and
+// "none", the preconditioner before; solvers/contact_gap_blocks.hpp), or with --compare
+// preconditioner_reuse whether a step keeps the preconditioner built at an earlier step's start
+// (solver.preconditioner_reuse: 0.1 lattice spacings, the default, against 0, built at every
+// step; solvers/preconditioner_cache.hpp; also prints how many steps kept it). Problem: the
+// Fig. 4.11 pair's full box (the example's run file) at a lower discretization order, fields 0, 5,
+// ..., 35 mT upwards: the pair snaps into contact on the way (seed profile; 79,054 nodes at the
+// default n_d = 3, where the default minimiser uses the multilevel preconditioner). Prints per step
+// the iterations with each choice, then the totals, the evaluations, the CPU time, the ratios, and
 // how far apart the two runs' states are (per step: the largest difference of a centre
 // coordinate and of M, the total energy's relative one). Exit status 1 if a step does not
 // converge or the two choices take identical paths (the setting would not have reached the
 // preconditioner).
 //
-//   ./build/node_scaling_bench [--order N] [--steps K] [--repeats R] [--compare contact_gap]
+//   ./build/node_scaling_bench [--order N] [--steps K] [--repeats R]
+//                              [--compare contact_gap | preconditioner_reuse]
 //
 // --order: the discretization order n_d (default 3); --steps: field steps after 0 mT, 5 mT
 // apart (default 7); --repeats: runs of each choice, alternating, the fastest CPU time kept
@@ -37,15 +41,23 @@ namespace mp = mresim::mess_protocol;
 
 using Run = mresim::bench::ProtocolRun;
 
-// solver.<key> = value.
+// solver.<key> = value (a TOML value: a string in quotes, or a number).
 Run run(const std::string& key, const std::string& value, int order, int steps) {
+  std::string label = value;
+  std::erase(label, '"');
   return mresim::bench::run_protocol(
       "examples/chapter4/fig4_11_pair_large_box_S6_5um.toml",
       {fmt::format("model.discretization_order={}", order),
        fmt::format("field.max={}", 0.005 * steps), fmt::format("field.steps={}", steps),
        "field.sequence=\"up\"", "output.node_positions=false", "output.checkpoint_every=0",
-       fmt::format("solver.{}=\"{}\"", key, value)},
-      value, [](const mp::StepRecord&) { return true; });
+       fmt::format("solver.{}={}", key, value)},
+      label, [](const mp::StepRecord&) { return true; });
+}
+
+// Steps that kept the multilevel preconditioner of an earlier step.
+long long kept_steps(const Run& r) {
+  return std::count_if(r.records.begin(), r.records.end(),
+                       [](const mp::StepRecord& s) { return s.preconditioner == "kept"; });
 }
 
 }  // namespace
@@ -61,14 +73,23 @@ int main(int argc, char** argv) {
       rest.push_back(argv[k]);
     }
   }
-  if (key != "node_scaling" && key != "contact_gap") {
-    std::fprintf(stderr, "--compare %s: one of node_scaling, contact_gap\n", key.c_str());
+  // The earlier choice first, then the default (TOML values).
+  using Values = std::pair<std::string, std::string>;
+  Values values;
+  if (key == "node_scaling") {
+    values = {"\"diagonal\"", "\"blocks\""};
+  } else if (key == "contact_gap") {
+    values = {"\"none\"", "\"exact\""};
+  } else if (key == "preconditioner_reuse") {
+    values = {"0", "0.1"};
+  } else {
+    std::fprintf(stderr, "--compare %s: one of node_scaling, contact_gap, preconditioner_reuse\n",
+                 key.c_str());
     return 2;
   }
-  // The earlier choice first, then the default.
-  const std::pair<std::string, std::string> values =
-      key == "node_scaling" ? std::pair<std::string, std::string>{"diagonal", "blocks"}
-                            : std::pair<std::string, std::string>{"none", "exact"};
+  Values labels = values;  // for the table: without the quotes
+  std::erase(labels.first, '"');
+  std::erase(labels.second, '"');
   const auto options =
       mresim::bench::parse_protocol_bench_options(static_cast<int>(rest.size()), rest.data(), 3, 7);
   if (!options) return 2;
@@ -88,10 +109,10 @@ int main(int argc, char** argv) {
   }
   std::printf("Fig. 4.11 pair, full box, n_d = %d: %lld nodes, fields 0 ... %g mT upwards\n", order,
               static_cast<long long>(earlier.nodes), 5.0 * steps);
-  std::printf("solver.%s: %s against %s\n", key.c_str(), values.first.c_str(),
-              values.second.c_str());
+  std::printf("solver.%s: %s against %s\n", key.c_str(), labels.first.c_str(),
+              labels.second.c_str());
   std::printf("  %4s %10s %9s %9s %28s %20s %12s %12s %12s\n", "step", "field (mT)",
-              values.first.c_str(), values.second.c_str(), "separation (um), each",
+              labels.first.c_str(), labels.second.c_str(), "separation (um), each",
               "pair angle (deg)", "centres (m)", "M (A/m)", "energy");
   // The pair axis's angle from the field's axis (z).
   const auto angle = [](const mp::StepRecord& r) {
@@ -112,13 +133,16 @@ int main(int argc, char** argv) {
                 (a.magnetization - b.magnetization).cwiseAbs().maxCoeff(),
                 total > 0.0 ? std::abs(a.energies.total() - b.energies.total()) / total : 0.0);
   }
-  for (const auto& [name, r] : {std::pair<const std::string&, const Run&>{values.first, earlier},
-                                {values.second, chosen}}) {
-    std::printf("  %-9s %6lld iterations, %6lld evaluations, CPU %8.2f s\n", name.c_str(),
-                static_cast<long long>(r.iterations), static_cast<long long>(r.evaluations), r.cpu);
+  for (const auto& [name, r] : {std::pair<const std::string&, const Run&>{labels.first, earlier},
+                                {labels.second, chosen}}) {
+    std::printf(
+        "  %-9s %6lld iterations, %6lld evaluations, CPU %8.2f s, %lld steps kept the "
+        "preconditioner\n",
+        name.c_str(), static_cast<long long>(r.iterations), static_cast<long long>(r.evaluations),
+        r.cpu, kept_steps(r));
   }
-  std::printf("  %s / %s: iterations %.2fx, evaluations %.2fx, CPU %.2fx\n", values.first.c_str(),
-              values.second.c_str(),
+  std::printf("  %s / %s: iterations %.2fx, evaluations %.2fx, CPU %.2fx\n", labels.first.c_str(),
+              labels.second.c_str(),
               static_cast<double>(earlier.iterations) / static_cast<double>(chosen.iterations),
               static_cast<double>(earlier.evaluations) / static_cast<double>(chosen.evaluations),
               earlier.cpu / chosen.cpu);

@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "../support/contact_pair.hpp"
 #include "../support/mess_test_support.hpp"
 #include "../support/multilevel_test_support.hpp"
 #include "../support/small_runs.hpp"
@@ -33,40 +34,14 @@ namespace {
 
 constexpr double kGapForceScale = 1e-9;  // N: any positive scale
 
-// Two particles (n_d = 2, R = 2.5 l_e) `apart` cells apart along z in a 12 x 12 x 20 box, all
-// faces held (physical profile), at rest.
-struct Pair {
-  explicit Pair(int apart, double field = 0.0)
-      : sys(mess::MessSystem::make(small_lattice(mess::model_profile("physical"), {12, 12, 20},
-                                                 {{6, 6, 7}, {6, 6, 7 + apart}}, 2),
-                                   tesla(0.0, 0.0, field), mess::model_profile("physical"))) {
-    const lat::Lattice& l = sys.lattice();
-    sys.set_constraints(faces_held(l, {lat::Face::left, lat::Face::right, lat::Face::front,
-                                       lat::Face::back, lat::Face::bottom, lat::Face::top}));
-    map = std::make_unique<mess::DofMap>(sys.constraints(), l.positions, l.element_length);
-  }
-  // Every free coordinate moved by up to 0.05 l_e (fixed seed): the springs leave their rest
-  // lengths, so the elastic Hessian differs from the stiffness terms the rest of P is built from.
-  void perturb() {
-    const double l_e = sys.lattice().element_length;
-    Eigen::Matrix3Xd x = sys.positions();
-    const Eigen::VectorXd shift = uniform_random_vector(3 * x.cols(), 21);
-    for (Eigen::Index n = 0; n < x.cols(); ++n) {
-      for (int a = 0; a < 3; ++a) {
-        if (map->dof_of(n, a) >= 0) x(a, n) += 0.05 * l_e * shift[3 * n + a];
-      }
-    }
-    sys.set_positions(x);
-  }
-  mess::MessSystem sys;
-  std::unique_ptr<mess::DofMap> map;
-};
+using Pair = mess::testing::ContactPair;
 
 TEST(ContactGap, OnlyAPairLessThanThreeRadiiApartHasAGap) {
   const Pair close(6);  // 6 l_e = 2.4 R
   const Pair far(8);    // 8 l_e = 3.2 R
-  const mess::ContactGapBlocks in_contact(close.sys, *close.map, kGapForceScale);
-  const mess::ContactGapBlocks apart(far.sys, *far.map, kGapForceScale);
+  const mess::ContactGapBlocks in_contact(close.sys, *close.map, kGapForceScale,
+                                          close.sys.positions());
+  const mess::ContactGapBlocks apart(far.sys, *far.map, kGapForceScale, far.sys.positions());
   EXPECT_EQ(in_contact.gaps(), 1U);
   EXPECT_EQ(in_contact.left_out(), 0);
   EXPECT_GT(in_contact.dofs(), 300);

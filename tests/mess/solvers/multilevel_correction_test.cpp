@@ -16,7 +16,7 @@
 #include "../support/mess_test_support.hpp"
 #include "../support/multilevel_test_support.hpp"
 #include "mresim/mess/solvers/minimiser.hpp"
-#include "mresim/mess/solvers/preconditioner.hpp"
+#include "mresim/mess/solvers/preconditioner_cache.hpp"
 
 namespace mess = mresim::mess;
 namespace lat = mresim::lattice;

@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <bit>
+#include <cstdint>
+#include <memory>
 #include <stdexcept>
 
 #include "mresim/io/hdf5_file.hpp"
@@ -20,6 +23,9 @@ constexpr std::int64_t kFormatVersion = 2;
 
 // ProtocolState::earlier_field_result, where the state holds one.
 constexpr const char* kEarlierFieldResult = "/earlier_field_result";
+// ProtocolState::preconditioner_anchor, where the state holds one: its positions (single
+// precision values, stored exactly as doubles) with the key as an attribute.
+constexpr const char* kPreconditionerAnchor = "/preconditioner_anchor";
 
 void write_optional(io::Hdf5File& file, const std::string& path, const Eigen::Matrix3Xd& m,
                     std::string_view unit) {
@@ -63,6 +69,12 @@ void write_checkpoint(const fs::path& file, const ProtocolState& state,
     if (state.earlier_field_result.cols() > 0) {
       write_optional(out, kEarlierFieldResult, state.earlier_field_result.load(), "m");
     }
+    if (state.preconditioner_anchor != nullptr) {
+      write_columns(out, kPreconditionerAnchor,
+                    state.preconditioner_anchor->positions.cast<double>(), "m");
+      out.write_int_attribute(kPreconditionerAnchor, "key",
+                              std::bit_cast<std::int64_t>(state.preconditioner_anchor->key));
+    }
     if (!state.records.empty()) {
       write_step_records(out, "/records", state.records, runner.system().particle_count(),
                          load_unit(runner.spec()), *runner.system().energy_labels());
@@ -103,6 +115,15 @@ ProtocolState read_checkpoint(const fs::path& file, const ProtocolRunner& runner
   }
   // Absent in checkpoints of runs without the field secant (and in those written before it).
   state.earlier_field_result = read_optional(in, kEarlierFieldResult, nodes);
+  // Absent in checkpoints of runs that build the preconditioner at every step (and in those
+  // written before it was kept).
+  const Eigen::Matrix3Xd anchor = read_optional(in, kPreconditionerAnchor, nodes);
+  if (anchor.cols() > 0) {
+    state.preconditioner_anchor =
+        std::make_shared<const mess::PreconditionerAnchor>(mess::PreconditionerAnchor{
+            anchor.cast<float>(),
+            std::bit_cast<std::uint64_t>(in.int_attribute(kPreconditionerAnchor, "key"))});
+  }
   if (next > 0) {
     state.records =
         read_step_records(in, "/records", runner.steps(), runner.system().particle_count(),

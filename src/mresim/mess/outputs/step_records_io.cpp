@@ -43,6 +43,14 @@ std::vector<std::int64_t> int_column(const std::vector<StepRecord>& records, Get
   return out;
 }
 
+std::vector<std::string> string_column(const std::vector<StepRecord>& records,
+                                       const std::string StepRecord::*member) {
+  std::vector<std::string> out;
+  out.reserve(records.size());
+  for (const StepRecord& r : records) out.push_back(r.*member);
+  return out;
+}
+
 // steps x particles x 3 from each record's 3 x N_p matrix.
 std::vector<double> stacked(const std::vector<StepRecord>& records,
                             const Eigen::Matrix3Xd StepRecord::*member) {
@@ -113,14 +121,10 @@ void write_step_records(io::Hdf5File& file, const std::string& group,
                         int_column(records, [](auto& r) { return r.evaluations; }));
   file.write_int_vector(s + "krylov_iterations",
                         int_column(records, [](auto& r) { return r.krylov_iterations; }));
-  std::vector<std::string> finished_by;
-  finished_by.reserve(records.size());
-  for (const StepRecord& r : records) finished_by.push_back(r.finished_by);
-  file.write_string_vector(s + "finished_by", finished_by);
-  std::vector<std::string> start;
-  start.reserve(records.size());
-  for (const StepRecord& r : records) start.push_back(r.start);
-  file.write_string_vector(s + "start", start);
+  file.write_string_vector(s + "finished_by", string_column(records, &StepRecord::finished_by));
+  file.write_string_vector(s + "start", string_column(records, &StepRecord::start));
+  file.write_string_vector(s + "preconditioner",
+                           string_column(records, &StepRecord::preconditioner));
   file.write_int_vector(s + "correction_passes",
                         int_column(records, [](auto& r) { return r.correction_passes; }));
   file.write_vector(s + "max_force", column(records, [](auto& r) { return r.max_force; }), "N");
@@ -196,6 +200,11 @@ std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std:
   const std::vector<std::string> start = file.exists(s + "start")
                                              ? file.strings(s + "start")
                                              : std::vector<std::string>(n, "unrecorded");
+  // Absent in files written before it was recorded: "unrecorded" (such runs built the
+  // multilevel preconditioner at every step's start).
+  const std::vector<std::string> preconditioner = file.exists(s + "preconditioner")
+                                                      ? file.strings(s + "preconditioner")
+                                                      : std::vector<std::string>(n, "unrecorded");
   const std::vector<std::int64_t> passes = file.exists(s + "correction_passes")
                                                ? ints(s + "correction_passes")
                                                : std::vector<std::int64_t>(n, 0);
@@ -210,7 +219,8 @@ std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std:
   const std::vector<std::int64_t> peak_memory = file.exists(s + "peak_resident_memory")
                                                     ? ints(s + "peak_resident_memory")
                                                     : std::vector<std::int64_t>(n, 0);
-  if (status.size() != n || method.size() != n || finished_by.size() != n || start.size() != n) {
+  if (status.size() != n || method.size() != n || finished_by.size() != n || start.size() != n ||
+      preconditioner.size() != n) {
     throw std::runtime_error("inconsistent solver data in " + group);
   }
   const auto np = static_cast<Eigen::Index>(particle_count);
@@ -229,6 +239,7 @@ std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std:
     r.krylov_iterations = krylov[i];
     r.finished_by = finished_by[i];
     r.start = start[i];
+    r.preconditioner = preconditioner[i];
     r.correction_passes = passes[i];
     r.max_force = max_force[i];
     r.magnetization_solves = solves[i];

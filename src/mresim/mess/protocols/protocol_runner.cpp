@@ -102,6 +102,7 @@ mess::MinimiserOptions ProtocolRunner::minimiser_options() const {
   options.preconditioner_cache = preconditioner_cache_;  // one for the run's steps
   options.node_scaling = spec_.solver.node_scaling;
   options.contact_gap = spec_.solver.contact_gap;
+  options.preconditioner_reuse = spec_.solver.preconditioner_reuse;
   options.force_tolerance = spec_.solver.minimiser.force_tolerance;
   options.max_iterations = static_cast<int>(spec_.solver.minimiser.max_iterations);
   options.observer = observer_;
@@ -210,6 +211,12 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   const auto started = std::chrono::steady_clock::now();
   const StepSpec& step = steps_[state.next_step];
   const lattice::Lattice& lat = system_.lattice();
+  // The state's preconditioner anchor (a resumed or extended run's) goes to the cache, and the
+  // state lets go of it while the step relaxes, so that a new anchor never waits beside it.
+  if (state.preconditioner_anchor != preconditioner_cache_->anchor()) {
+    preconditioner_cache_->restore(lat, state.preconditioner_anchor);
+  }
+  state.preconditioner_anchor.reset();
 
   // Boundary conditions (the protocol's): loaded steps of a protocol that says so are measured
   // from the zero-load state at this field.
@@ -250,6 +257,7 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
     record.krylov_iterations = r.krylov_iterations;
     record.finished_by = finished_by_name(r, spec_.solver.method == mc::SolverMethod::newton);
     record.correction_passes = r.correction_passes;
+    if (!r.state_preconditioner.empty()) record.preconditioner = r.state_preconditioner;
     record.max_force = r.max_force;
     record.energies = r.final.energies;
   } else {
@@ -300,6 +308,7 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   record.peak_resident_memory = app::peak_resident_memory_bytes();
   state.records.push_back(std::move(record));
+  state.preconditioner_anchor = preconditioner_cache_->anchor();
   ++state.next_step;
   return state.records.back();
 }

@@ -36,7 +36,7 @@
 #include "mresim/mess/protocols/step_plan.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
 #include "mresim/mess/solvers/newton.hpp"
-#include "mresim/mess/solvers/preconditioner.hpp"
+#include "mresim/mess/solvers/preconditioner_cache.hpp"
 #include "mresim/mess/solvers/relaxation_observer.hpp"
 #include "mresim/mess/system/system_energy.hpp"
 
@@ -70,6 +70,9 @@ struct StepRecord {
   // took over, so that a slow step can be traced to FIRE or the slope-only search.
   std::string finished_by;
   std::int64_t correction_passes = 0;  // seed profile, L-BFGS: correction passes for its forces
+  // The multilevel preconditioner of the step's L-BFGS (solvers/preconditioner_cache.hpp):
+  // "built" at the step's start, "kept" from an earlier step's start; "none" without one.
+  std::string preconditioner = "none";
   // Where the relaxation started (load_step_start.hpp, step_start::): "initial_lattice",
   // "previous", "secant", "neighbour_field", "previous_prediction_rejected".
   std::string start;
@@ -101,6 +104,10 @@ struct ProtocolState {
   // from `references`.
   KeptPositions earlier_field_result;
   std::vector<StepRecord> records;  // of steps 0 .. next_step - 1
+  // Where the multilevel preconditioner the next step may keep was built (solvers/
+  // preconditioner_cache.hpp), shared with the runner's cache; null: none (the next step builds
+  // one). Checkpoints hold it, so that a resumed run keeps or builds as the uninterrupted one.
+  std::shared_ptr<const mess::PreconditionerAnchor> preconditioner_anchor;
   // Where the positions of the fields a step does not work on are parked (kept_positions.hpp);
   // null: all in memory. ProtocolRunner::run_next_step creates it when the runner has a
   // scratch directory (set_scratch_directory) and the state has more than one slot.

@@ -81,7 +81,7 @@ class ExtendPlan final : public app::RunPlan {
     ProtocolRunner extended(extended_spec_);
     extended.set_scratch_directory(staging_dir);
     const std::size_t shared = extension_.shared;
-    const std::size_t start = last_restorable(saved, extended, shared);
+    const std::size_t start = last_restorable(saved, extended, shared, NextStep::as_the_run);
     const std::size_t total = saved.steps.size();
     if (shared < total) {
       std::cerr << fmt::format(
@@ -91,7 +91,8 @@ class ExtendPlan final : public app::RunPlan {
     }
     if (start < shared) {
       std::cerr << fmt::format(
-          "mresim: the state after step {} was not kept ([output] node_positions = false); "
+          "mresim: the state after step {} was not kept ([output] node_positions = false, or "
+          "the multilevel preconditioner the next step keeps was built at an earlier step); "
           "steps {} to {} are computed again from step {} (same results)\n",
           shared - 1, start, shared - 1, start);
     }

@@ -148,14 +148,15 @@ class RerunPlan final : public app::RunPlan {
   // settings. `progress`: rank 0's (or a single process's), null on the other processes.
   StepRecord relax_step(const SavedRun& saved, const ProtocolRunner& computed,
                         ProtocolRunner& rerunner, app::Progress* progress) const {
-    const std::size_t start = last_restorable(saved, computed, step_);
+    const std::size_t start = last_restorable(saved, computed, step_, NextStep::afresh);
     if (progress != nullptr) progress->set_total(step_ - start + 1);
     ProtocolState state = *state_after(saved, computed, start);
     if (start < step_) {
       if (progress != nullptr) {
         std::cerr << fmt::format(
-            "mresim: the state before step {} was not kept ([output] node_positions = false); "
-            "steps {} to {} are computed again first with the run's settings\n",
+            "mresim: the state before step {} was not kept ([output] node_positions = false, "
+            "or a multilevel preconditioner kept from an earlier step is needed); steps {} to {} "
+            "are computed again first with the run's settings\n",
             step_, start, step_ - 1);
       }
       ProtocolRunner again(computed_spec_);

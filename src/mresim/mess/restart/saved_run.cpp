@@ -69,6 +69,7 @@ SavedRun read_saved_run(const fs::path& dir, const ProtocolRunner& runner,
                                            saved.steps.size()));
     }
     take_final_state(final, saved.steps, saved.positions);
+    saved.final_anchor = std::move(final.preconditioner_anchor);
     saved.records = final.records;
     saved.has_final_state = true;
   } else {
@@ -136,6 +137,22 @@ bool restorable(const SavedRun& saved, const ProtocolRunner& runner, const Proto
          kept(saved, {sources.earlier_field_result});
 }
 
+// Whether a run continued from the state after `count` steps builds or keeps the multilevel
+// preconditioner as the saved run did (preconditioner_cache.hpp): where the step after it may
+// keep one built before, the anchor it was built at must be known. It is for the final state
+// (final_state.h5 holds it) and where no anchor was in effect; a next step that is the saved
+// run's own and built its preconditioner at its start needs none either.
+bool anchor_known(const SavedRun& saved, const ProtocolRunner& runner, std::size_t count,
+                  bool next_step_is_saved) {
+  if (next_step_is_saved && count < saved.records.size()) {
+    return saved.records[count].preconditioner != "kept";
+  }
+  if (count == 0 || runner.spec().solver.preconditioner_reuse <= 0.0) return true;
+  if (count == saved.steps.size() && saved.has_final_state) return true;
+  const std::string& before = saved.records[count - 1].preconditioner;
+  return before != "built" && before != "kept";
+}
+
 }  // namespace
 
 std::optional<ProtocolState> state_after(const SavedRun& saved, const ProtocolRunner& runner,
@@ -159,17 +176,21 @@ std::optional<ProtocolState> state_after(const SavedRun& saved, const ProtocolRu
   if (sources.earlier_field_result) {
     state.earlier_field_result = saved.positions.at(*sources.earlier_field_result).load();
   }
+  if (count == saved.steps.size()) state.preconditioner_anchor = saved.final_anchor;
   state.records.assign(saved.records.begin(),
                        saved.records.begin() + static_cast<std::ptrdiff_t>(count));
   state.next_step = count;
   return state;
 }
 
-std::size_t last_restorable(const SavedRun& saved, const ProtocolRunner& runner,
-                            std::size_t count) {
+std::size_t last_restorable(const SavedRun& saved, const ProtocolRunner& runner, std::size_t count,
+                            NextStep next) {
   const ProtocolState initial = runner.initial_state();
-  for (std::size_t k = std::min(count, runner.steps().size()); k > 0; --k) {
-    if (restorable(saved, runner, initial, k)) return k;
+  const std::size_t last = std::min(count, runner.steps().size());
+  for (std::size_t k = last; k > 0; --k) {
+    if (!restorable(saved, runner, initial, k)) continue;
+    if (k == last && next == NextStep::afresh) return k;
+    if (anchor_known(saved, runner, k, k < last)) return k;
   }
   return 0;
 }

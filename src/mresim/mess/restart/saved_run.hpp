@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -53,6 +54,9 @@ struct SavedRun {
   std::vector<StepRecord> records;                  // every step's record
   std::map<std::size_t, SavedPositions> positions;  // by step, where kept
   bool has_final_state = false;
+  // Where the multilevel preconditioner kept after the last step was built (final_state.h5;
+  // ProtocolState::preconditioner_anchor); null: none, or no final state.
+  std::shared_ptr<const mess::PreconditionerAnchor> final_anchor;
 };
 
 // Reads the run in `dir` (results.h5, final_state.h5; of positions/ only which steps have a
@@ -68,8 +72,18 @@ SavedRun read_saved_run(const std::filesystem::path& dir, const ProtocolRunner& 
 std::optional<ProtocolState> state_after(const SavedRun& saved, const ProtocolRunner& runner,
                                          std::size_t count);
 
-// The largest k <= count whose state_after is available (0 always is).
-std::size_t last_restorable(const SavedRun& saved, const ProtocolRunner& runner, std::size_t count);
+// What follows the state after `count` steps where last_restorable looks for one: a step the
+// run goes on with as a run of the runner's file would (extend), which must keep or build the
+// multilevel preconditioner as that run did; or one relaxed afresh with its own (rerun).
+enum class NextStep { as_the_run, afresh };
+
+// The largest k <= count whose state_after is available (0 always is) and from which the steps
+// up to `count` continue as the saved run did, step `count` itself as `next` says: where the
+// saved run kept its multilevel preconditioner from an earlier step, a state is taken only
+// where the preconditioner's anchor is known (the final state) or not needed (the next step
+// built its own), so that the continued steps are the saved run's bit for bit.
+std::size_t last_restorable(const SavedRun& saved, const ProtocolRunner& runner, std::size_t count,
+                            NextStep next);
 
 // A kept file of the finished run into the staging directory: a hard link (mresim never writes
 // these files in place, it replaces them), a copy where links are not possible.

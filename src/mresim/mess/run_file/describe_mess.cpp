@@ -11,6 +11,7 @@
 #include "mresim/core/constants.hpp"
 #include "mresim/mess/protocols/protocol.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
+#include "mresim/mess/solvers/minimiser.hpp"
 
 namespace mresim::mess_config {
 
@@ -259,6 +260,11 @@ void describe_solver(const MessSpec& s, app::InfoReport& r) {
                        "contact exactly"
                      : "the polymer between particles in contact is left to the node scaling "
                        "(before the gap blocks)");
+      r.add(sec, "preconditioner_reuse", v.preconditioner_reuse, "l_e",
+            v.preconditioner_reuse > 0.0
+                ? "a step keeps the multilevel preconditioner of an earlier step's start while "
+                  "no node has moved further and the same particles are in contact"
+                : "the multilevel preconditioner is built at every step's start");
     }
   } else {
     const lattice::LatticeSpec& l = s.lattice;
@@ -355,10 +361,15 @@ void describe_mess(const MessSpec& s, app::InfoReport& r) {
                 s.output.checkpoint_every == 0 ? "no checkpoints" : "");
   // final_state.h5: the positions of every slot (one per field with a load) and the zero-load
   // references, float64 (restart/saved_run.hpp); with one slot and predicted field steps also
-  // the result before the last (ProtocolState::earlier_field_result).
+  // the result before the last (ProtocolState::earlier_field_result); where the multilevel
+  // preconditioner is kept between steps, the positions it was built at (its anchor).
   const bool earlier_result = s.solver.field_step_start == FieldStepStart::extrapolated;
-  const double slots = s.load_step_count() > 1 ? 2.0 * static_cast<double>(s.field.values.size())
-                                               : (earlier_result ? 2.0 : 1.0);
+  const bool anchor = s.solver.method == SolverMethod::minimiser &&
+                      s.solver.preconditioner_reuse > 0.0 &&
+                      s.geometry.node_count() >= mess::kMultilevelMinimumNodes;
+  const double slots = (s.load_step_count() > 1 ? 2.0 * static_cast<double>(s.field.values.size())
+                                                : (earlier_result ? 2.0 : 1.0)) +
+                       (anchor ? 1.0 : 0.0);
   r.add_text("output", "keep_final_state", s.output.keep_final_state ? "on" : "off",
              s.output.keep_final_state
                  ? fmt::format("final_state.h5 of {:.3g} MB, for mresim extend and rerun",

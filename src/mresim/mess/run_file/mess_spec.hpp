@@ -192,6 +192,10 @@ struct SolverSpec {
   // method = "minimiser" only: whether that preconditioner solves the polymer between particles
   // in contact exactly (solvers/contact_gap_blocks.hpp).
   mess::ContactGap contact_gap = mess::ContactGap::exact;
+  // method = "minimiser" only: the largest node displacement (lattice spacings) from the state
+  // that preconditioner was built at up to which a step keeps it (solvers/preconditioner_cache
+  // .hpp); 0: built at every step's start.
+  double preconditioner_reuse = 0.1;
   MinimiserSettings minimiser;
   LeapfrogSettings leapfrog;
   // atol, rtol, iteration budgets; `demagnetization` mirrors MessSpec::demagnetization.

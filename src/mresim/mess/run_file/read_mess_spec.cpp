@@ -556,9 +556,10 @@ void read_solver(const std::optional<TableReader>& solver, bool demagnetization,
       "field_step_start",
       s.method == SolverMethod::leapfrog ? FieldStepStart::previous : FieldStepStart::extrapolated,
       {{"extrapolated", FieldStepStart::extrapolated}, {"previous", FieldStepStart::previous}});
-  // Only the minimiser's multilevel preconditioner scales nodes by blocks and solves the gaps
-  // between particles in contact; the other methods would ignore the choices.
-  for (const char* key : {"node_scaling", "contact_gap"}) {
+  // Only the minimiser's multilevel preconditioner scales nodes by blocks, solves the gaps
+  // between particles in contact and is kept between steps; the other methods would ignore
+  // the choices.
+  for (const char* key : {"node_scaling", "contact_gap", "preconditioner_reuse"}) {
     if (t.has(key) && s.method != SolverMethod::minimiser) {
       t.fail(key, t.value_text(key),
              fmt::format(R"(only read with solver.method = "minimiser" (the method is "{}"))",
@@ -571,6 +572,8 @@ void read_solver(const std::optional<TableReader>& solver, bool demagnetization,
   s.contact_gap =
       t.enumeration_or("contact_gap", mess::ContactGap::exact,
                        {{"exact", mess::ContactGap::exact}, {"none", mess::ContactGap::none}});
+  s.preconditioner_reuse =
+      t.number_or("preconditioner_reuse", s.preconditioner_reuse, Range::between(0.0, 10.0), "l_e");
   // [solver.minimiser] holds the criteria of lbfgs and newton alike.
   const std::string other = method == "leapfrog" ? "minimiser" : "leapfrog";
   if (t.has(other)) {

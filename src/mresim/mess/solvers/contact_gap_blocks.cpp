@@ -71,13 +71,13 @@ class GapSink final : public HessianBlockSink {
 }  // namespace
 
 std::vector<std::int64_t> ContactGapBlocks::gap_nodes(const MessSystem& system, const DofMap& map,
+                                                      const Eigen::Matrix3Xd& x,
                                                       const Eigen::Vector3d& first,
                                                       const Eigen::Vector3d& second) {
   const lattice::Lattice& lat = system.lattice();
   const double radius = lat.particle_radius;
   const Eigen::Vector3d mid = 0.5 * (first + second);
   const Eigen::Vector3d axis = (second - first).normalized();
-  const Eigen::Matrix3Xd& x = system.positions();
   std::vector<std::int64_t> nodes;
   for (std::int64_t n = 0; n < lat.node_count(); ++n) {
     if (lat.particle_of_node[static_cast<std::size_t>(n)] >= 0) continue;
@@ -94,38 +94,48 @@ std::vector<std::int64_t> ContactGapBlocks::gap_nodes(const MessSystem& system, 
   return nodes;
 }
 
-ContactGapBlocks::ContactGapBlocks(const MessSystem& system, const DofMap& map,
-                                   double force_scale) {
-  const lattice::Lattice& lat = system.lattice();
-  const Eigen::Matrix3Xd centres = system.particle_centres(CentreRule::all_nodes);
-  const double contact = kContactSeparation * lat.particle_radius;
-  const double scale = lat.element_length / force_scale;
-  std::vector<std::int32_t> local;  // node -> its index in the current gap, or -1
+std::vector<std::pair<int, int>> ContactGapBlocks::contact_pairs(const Eigen::Matrix3Xd& centres,
+                                                                 double particle_radius) {
+  const double contact = kContactSeparation * particle_radius;
+  std::vector<std::pair<int, int>> pairs;
   for (Eigen::Index p = 0; p < centres.cols(); ++p) {
     for (Eigen::Index q = p + 1; q < centres.cols(); ++q) {
-      if ((centres.col(q) - centres.col(p)).norm() >= contact) continue;
-      const std::vector<std::int64_t> nodes =
-          gap_nodes(system, map, centres.col(p), centres.col(q));
-      if (nodes.empty()) continue;
-      local.assign(static_cast<std::size_t>(lat.node_count()), -1);
-      Gap gap;
-      for (std::size_t k = 0; k < nodes.size(); ++k) {
-        local[static_cast<std::size_t>(nodes[k])] = static_cast<std::int32_t>(k);
-        for (int a = 0; a < 3; ++a) gap.dofs.push_back(map.own_dof_of_coordinate(3 * nodes[k] + a));
+      if ((centres.col(q) - centres.col(p)).norm() < contact) {
+        pairs.emplace_back(static_cast<int>(p), static_cast<int>(q));
       }
-      Eigen::SparseMatrix<float> lower;
-      {
-        GapSink sink(lat.shape, local, nodes.size(), scale);
-        system.add_elastic_hessian_blocks(sink);
-        lower = sink.lower_matrix(nodes);
-      }
-      gap.factor = std::make_unique<Eigen::SimplicialLLT<Eigen::SparseMatrix<float>>>(lower);
-      if (gap.factor->info() != Eigen::Success) {
-        ++left_out_;  // not positive definite (header)
-        continue;
-      }
-      gaps_.push_back(std::move(gap));
     }
+  }
+  return pairs;
+}
+
+ContactGapBlocks::ContactGapBlocks(const MessSystem& system, const DofMap& map, double force_scale,
+                                   const Eigen::Matrix3Xd& at) {
+  const lattice::Lattice& lat = system.lattice();
+  const Eigen::Matrix3Xd centres = system.particle_centres_at(at, CentreRule::all_nodes);
+  const double scale = lat.element_length / force_scale;
+  std::vector<std::int32_t> local;  // node -> its index in the current gap, or -1
+  for (const auto& [p, q] : contact_pairs(centres, lat.particle_radius)) {
+    const std::vector<std::int64_t> nodes =
+        gap_nodes(system, map, at, centres.col(p), centres.col(q));
+    if (nodes.empty()) continue;
+    local.assign(static_cast<std::size_t>(lat.node_count()), -1);
+    Gap gap;
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      local[static_cast<std::size_t>(nodes[k])] = static_cast<std::int32_t>(k);
+      for (int a = 0; a < 3; ++a) gap.dofs.push_back(map.own_dof_of_coordinate(3 * nodes[k] + a));
+    }
+    Eigen::SparseMatrix<float> lower;
+    {
+      GapSink sink(lat.shape, local, nodes.size(), scale);
+      system.add_elastic_hessian_blocks(sink, at);
+      lower = sink.lower_matrix(nodes);
+    }
+    gap.factor = std::make_unique<Eigen::SimplicialLLT<Eigen::SparseMatrix<float>>>(lower);
+    if (gap.factor->info() != Eigen::Success) {
+      ++left_out_;  // not positive definite (header)
+      continue;
+    }
+    gaps_.push_back(std::move(gap));
   }
 }
 

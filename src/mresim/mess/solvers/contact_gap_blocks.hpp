@@ -14,11 +14,12 @@
 // midpoint, 0.4 % of the box (bench/preconditioned_spectrum_bench.cpp). The diagonal or node
 // blocks cannot describe them, and the coarse levels, built from the positive stiffness terms,
 // do not see them. Solving the gap exactly takes them out: conjugate gradients on P H needed
-// 1.65x fewer iterations for six decades there, and L-BFGS 2.2-2.4x fewer on single full-size
+// 1.65x fewer iterations for six decades there, and L-BFGS 2.1-2.4x fewer on single full-size
 // steps in contact (docs/performance.md, "The polymer between particles in contact").
 //
-// Where. The gaps are found, and their blocks taken, at the system's current positions: where
-// the minimisers build the preconditioner (the state it is built at).
+// Where. The gaps are found, and their blocks taken, at the state the preconditioner is built
+// at: the positions of the relaxation's start, or of an earlier one's where the minimisers keep
+// the preconditioner (PreconditionerCache, preconditioner.hpp).
 //
 // Which gaps. A pair of particles whose centres (the mean of their nodes) are less than
 // kContactSeparation radii apart, i.e. less than one radius of polymer between their surfaces.
@@ -42,6 +43,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "mresim/mess/system/constraints.hpp"
@@ -55,9 +57,15 @@ class ContactGapBlocks {
   static constexpr double kGapHalfLength = 1.0;      // along the pair's axis, radii
   static constexpr double kGapRadius = 5.0 / 3.0;    // from the axis, radii
 
-  // The gaps of the system at its current positions, scaled like the preconditioner's variables
-  // (H l_e / force_scale). `map`: the minimiser's.
-  ContactGapBlocks(const MessSystem& system, const DofMap& map, double force_scale);
+  // The gaps of the system at positions `at` (3 x N, m), scaled like the preconditioner's
+  // variables (H l_e / force_scale). `map`: the minimiser's.
+  ContactGapBlocks(const MessSystem& system, const DofMap& map, double force_scale,
+                   const Eigen::Matrix3Xd& at);
+
+  // The particle pairs (p < q, in order) that get a gap: `centres` (the mean of their nodes,
+  // 3 x N_p) less than kContactSeparation radii apart.
+  static std::vector<std::pair<int, int>> contact_pairs(const Eigen::Matrix3Xd& centres,
+                                                        double particle_radius);
 
   // w += sum_g R_g^T H_g^-1 R_g v (v, w over the map's dofs).
   void add_to(const Eigen::VectorXd& v, Eigen::VectorXd& w) const;
@@ -73,8 +81,10 @@ class ContactGapBlocks {
     std::vector<Eigen::Index> dofs;  // the map's dof of each local coordinate
     std::unique_ptr<Eigen::SimplicialLLT<Eigen::SparseMatrix<float>>> factor;
   };
-  // The polymer nodes of the gap between particles centred at `first` and `second` (header).
+  // The polymer nodes of the gap between particles centred at `first` and `second` (header),
+  // at positions `x`.
   static std::vector<std::int64_t> gap_nodes(const MessSystem& system, const DofMap& map,
+                                             const Eigen::Matrix3Xd& x,
                                              const Eigen::Vector3d& first,
                                              const Eigen::Vector3d& second);
   std::vector<Gap> gaps_;

@@ -13,7 +13,7 @@
 #include "mresim/mess/solvers/leapfrog.hpp"
 #include "mresim/mess/solvers/line_search.hpp"
 #include "mresim/mess/solvers/newton.hpp"
-#include "mresim/mess/solvers/preconditioner.hpp"
+#include "mresim/mess/solvers/preconditioner_cache.hpp"
 #include "mresim/mess/solvers/relaxation_common.hpp"
 #include "mresim/mess/solvers/vector_algebra.hpp"
 
@@ -58,6 +58,9 @@ void MinimiserOptions::validate() const {
   if (max_outer_iterations < 1) fail("max_outer_iterations must be >= 1");
   if (lbfgs_memory < 1) fail("lbfgs_memory must be >= 1");
   if (!(max_step > 0.0)) fail("max_step must be > 0");
+  if (!(preconditioner_reuse >= 0.0) || !std::isfinite(preconditioner_reuse)) {
+    fail("preconditioner_reuse must be finite and >= 0");
+  }
   if (!(correction_forcing >= 0.0 && correction_forcing < 1.0)) {
     fail("correction_forcing must be in [0, 1)");
   }
@@ -325,11 +328,17 @@ class Minimisation {
       preconditioner_ =
           options.preconditioner_cache != nullptr
               ? options.preconditioner_cache->get(system, map, force_scale, multilevel, processes,
-                                                  options.node_scaling, options.contact_gap)
+                                                  options.node_scaling, options.contact_gap,
+                                                  options.preconditioner_reuse)
               : std::make_shared<const RigidParticlePreconditioner>(
                     system, map, force_scale, multilevel,
                     multilevel ? &system.positions() : nullptr,  // as the cache builds it
                     processes, options.node_scaling, options.contact_gap);
+      if (multilevel) {
+        const bool kept =
+            options.preconditioner_cache != nullptr && options.preconditioner_cache->last_kept();
+        res_.state_preconditioner = kept ? "kept" : "built";
+      }
     }
     const bool single = options.lbfgs_history == LbfgsHistoryPrecision::single_precision ||
                         (options.lbfgs_history == LbfgsHistoryPrecision::automatic && multilevel);

@@ -130,7 +130,7 @@ struct NewtonOptions {
 };
 
 struct NewtonCache;          // newton.hpp
-class PreconditionerCache;   // preconditioner.hpp
+class PreconditionerCache;   // preconditioner_cache.hpp
 class DistributedEvaluator;  // distributed/distributed_evaluator.hpp
 
 struct MinimiserOptions {
@@ -158,6 +158,10 @@ struct MinimiserOptions {
   // multilevel and rigid_particles: where the preconditioner is kept between calls (a caller
   // relaxing many steps of one system keeps one; null: built anew in every call).
   std::shared_ptr<PreconditionerCache> preconditioner_cache;
+  // With the multilevel preconditioner and a cache: the largest node displacement, in lattice
+  // spacings, from the state the kept preconditioner was built at up to which a call keeps it
+  // (preconditioner_cache.hpp); 0: built anew at every call's start.
+  double preconditioner_reuse = 0.1;
   double max_step = 0.2;  // largest coordinate change per iteration, in units of l_e
   // Seed profile, lbfgs: inexact defect correction. The conservative phase stops once its
   // largest force is below correction_forcing x the largest difference between the seed's and
@@ -187,14 +191,17 @@ struct MinimiserResult {
   bool converged = false;
   int iterations = 0;        // inner iterations (L-BFGS steps or FIRE steps)
   int outer_iterations = 0;  // magnetization re-solves between minimisations (alternating)
-  bool switched_to_alternating = false;   // every_evaluation fell back to alternating
-  bool forces_only_phase = false;         // seed: relaxed further to the seed's own forces
-  bool finished_with_fire = false;        // lbfgs's line search failed; FIRE finished
-  bool finished_with_lbfgs = false;       // newton's line search failed; L-BFGS went on
-  int correction_passes = 0;              // seed: correction passes for its forces (L-BFGS)
-  bool slope_only_fallback = false;       // seed: L-BFGS went on with the slope-only search
-  std::int64_t evaluations = 0;           // energy + gradient evaluations
-  std::int64_t krylov_iterations = 0;     // newton: CG iterations (Hessian products)
+  bool switched_to_alternating = false;  // every_evaluation fell back to alternating
+  bool forces_only_phase = false;        // seed: relaxed further to the seed's own forces
+  bool finished_with_fire = false;       // lbfgs's line search failed; FIRE finished
+  bool finished_with_lbfgs = false;      // newton's line search failed; L-BFGS went on
+  int correction_passes = 0;             // seed: correction passes for its forces (L-BFGS)
+  bool slope_only_fallback = false;      // seed: L-BFGS went on with the slope-only search
+  std::int64_t evaluations = 0;          // energy + gradient evaluations
+  std::int64_t krylov_iterations = 0;    // newton: CG iterations (Hessian products)
+  // L-BFGS's preconditioner built at a state (the multilevel one): "built" at this call's
+  // start, "kept" from an earlier call's (preconditioner_cache.hpp); "" where there is none.
+  std::string state_preconditioner;
   double preconditioner_seconds = 0.0;    // newton: building the multigrid (0 when reused)
   double multigrid_seconds = 0.0;         // newton: applying it (V-cycles)
   double hessian_product_seconds = 0.0;   // newton: Hessian-vector products

@@ -38,8 +38,8 @@
 // 3 x 3 x 3 level points around it, one thread per level, the coarsest (which also sums the
 // lower triangle of its neighbour blocks, all its sparse factor reads) first: about 1.5 s at
 // 285k nodes on 2 threads. It depends on the lattice, the free coordinates, the force scale and
-// the state; a run builds one at each relaxation's starting state (PreconditionerCache,
-// preconditioner.hpp).
+// the state; a run builds one at a relaxation's starting state and keeps it while the lattice
+// stays close to that state (PreconditionerCache, preconditioner_cache.hpp).
 //
 // Over MPI processes (a BlockSplit of more than one process, docs/mpi.md) the levels are
 // built by different processes, each level by one, the coarsest by the first, and shared

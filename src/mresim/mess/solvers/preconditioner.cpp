@@ -3,7 +3,6 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <Eigen/QR>
-#include <bit>
 #include <cmath>
 #include <stdexcept>
 
@@ -76,12 +75,16 @@ RigidParticlePreconditioner::RigidParticlePreconditioner(
     if (!(diagonal[k] > 0.0)) diagonal[k] = 1.0;
   }
   inverse_diagonal_ = diagonal.cwiseInverse();
+  diagonal.resize(0);
   if (blocks) invert_node_blocks(lat, map, d, off, scale);
+  // Released before the gaps and the coarse levels are built (72 bytes per node with these).
+  d.resize(3, 0);
+  off.resize(3, 0);
   rigid_stiffness_ = polymer_count > 0 ? polymer_sum / static_cast<double>(polymer_count) : 1.0;
 
   add_particle_blocks(lat, map, x);
   if (state != nullptr && contact_gap == ContactGap::exact) {
-    auto gaps = std::make_unique<ContactGapBlocks>(system, map, force_scale);
+    auto gaps = std::make_unique<ContactGapBlocks>(system, map, force_scale, *state);
     if (gaps->gaps() > 0) contact_gaps_ = std::move(gaps);
   }
   if (multilevel) {
@@ -203,64 +206,6 @@ Eigen::VectorXd RigidParticlePreconditioner::apply(const DofMap& map,
   if (multilevel_ != nullptr) multilevel_->add_to(map, v, w);
   if (contact_gaps_ != nullptr) contact_gaps_->add_to(v, w);
   return w;
-}
-
-namespace {
-
-// FNV-1a over what a preconditioner depends on besides the lattice.
-class Fingerprint {
- public:
-  void add(std::uint64_t value) {
-    for (int byte = 0; byte < 8; ++byte) {
-      hash_ ^= (value >> (8 * byte)) & 0xffU;
-      hash_ *= 0x100000001b3ULL;
-    }
-  }
-  std::uint64_t value() const { return hash_; }
-
- private:
-  std::uint64_t hash_ = 0xcbf29ce484222325ULL;
-};
-
-std::uint64_t preconditioner_key(const MessSystem& system, const DofMap& map, double force_scale,
-                                 bool multilevel) {
-  Fingerprint f;
-  f.add(multilevel ? 1U : 0U);
-  f.add(std::bit_cast<std::uint64_t>(force_scale));
-  f.add(std::bit_cast<std::uint64_t>(system.settings().elastic.volume_force_factor));
-  f.add(static_cast<std::uint64_t>(map.size()));
-  for (Eigen::Index k = 0; k < map.own_dofs(); ++k) {
-    f.add(static_cast<std::uint64_t>(map.coordinate_of(k)));
-  }
-  for (Eigen::Index g = 0; g < map.groups(); ++g) {
-    f.add(static_cast<std::uint64_t>(map.group_nodes(g).size()));
-    for (const std::int32_t n : map.group_nodes(g)) f.add(static_cast<std::uint64_t>(n));
-  }
-  return f.value();
-}
-
-}  // namespace
-
-std::shared_ptr<const RigidParticlePreconditioner> PreconditionerCache::get(
-    const MessSystem& system, const DofMap& map, double force_scale, bool multilevel,
-    const detail::BlockSplit* processes, NodeScaling node_scaling, ContactGap contact_gap) {
-  const std::uint64_t key = preconditioner_key(system, map, force_scale, multilevel);
-  if (multilevel) {
-    kept_.reset();  // before the new one is built: never two at once
-    kept_ = std::make_shared<const RigidParticlePreconditioner>(
-        system, map, force_scale, true, &system.positions(), processes, node_scaling, contact_gap);
-    lattice_ = &system.lattice();
-    key_ = key;
-    ++builds_;
-  } else if (kept_ == nullptr || lattice_ != &system.lattice() || key != key_) {
-    kept_.reset();
-    kept_ =
-        std::make_shared<const RigidParticlePreconditioner>(system, map, force_scale, multilevel);
-    lattice_ = &system.lattice();
-    key_ = key;
-    ++builds_;
-  }
-  return kept_;
 }
 
 }  // namespace mresim::mess

@@ -43,10 +43,12 @@
 // are symmetric about it, and its block is diagonal.
 //
 // Built at rest (the reference lattice), P depends only on the lattice, the free coordinates and
-// the force scale, so a run relaxing many steps keeps one (PreconditionerCache) while its free
-// coordinates stay: the plain P of `method = "lbfgs"` and of small lattices. With the multilevel
-// correction it is built at each relaxation's starting state instead (PreconditionerCache::get):
-// large lattices are where particles in contact deform the polymer far from its rest shape.
+// the force scale, so a run relaxing many steps keeps one (PreconditionerCache,
+// preconditioner_cache.hpp) while its free coordinates stay: the plain P of `method = "lbfgs"`
+// and of small lattices. With the multilevel correction it is built at a state instead: large
+// lattices are where particles in contact deform the polymer far from its rest shape. The cache
+// builds it at a relaxation's start and keeps it while the state stays close to where it was
+// built.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -121,28 +123,6 @@ class RigidParticlePreconditioner {
   std::vector<Block> blocks_;
   std::unique_ptr<MultilevelCorrection> multilevel_;
   std::unique_ptr<ContactGapBlocks> contact_gaps_;
-};
-
-// A run's preconditioner, kept across its relaxations. Without the multilevel correction it is
-// built at rest and rebuilt only when what it depends on changes (the free coordinates and rigid
-// groups, the force scale, the multilevel choice). With it, every get() builds a new one at the
-// system's positions (the starting state of the relaxation that asks), after releasing the kept
-// one, so that two are never held at once (peak memory).
-class PreconditionerCache {
- public:
-  // The preconditioner for these arguments (see above); `processes`, `node_scaling` and
-  // `contact_gap` as for the constructor.
-  std::shared_ptr<const RigidParticlePreconditioner> get(
-      const MessSystem& system, const DofMap& map, double force_scale, bool multilevel,
-      const detail::BlockSplit* processes = nullptr, NodeScaling node_scaling = NodeScaling::blocks,
-      ContactGap contact_gap = ContactGap::exact);
-  int builds() const { return builds_; }
-
- private:
-  std::shared_ptr<const RigidParticlePreconditioner> kept_;
-  const lattice::Lattice* lattice_ = nullptr;
-  std::uint64_t key_ = 0;
-  int builds_ = 0;
 };
 
 }  // namespace mresim::mess

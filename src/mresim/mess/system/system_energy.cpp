@@ -133,6 +133,10 @@ Eigen::Matrix3Xd MessSystem::particle_centres() const {
 }
 
 Eigen::Matrix3Xd MessSystem::particle_centres(CentreRule rule) const {
+  return particle_centres_at(positions_, rule);
+}
+
+Eigen::Matrix3Xd MessSystem::particle_centres_at(const Eigen::Matrix3Xd& x, CentreRule rule) const {
   const auto np = static_cast<Eigen::Index>(lattice_.particle_count());
   Eigen::Matrix3Xd c(3, np);
   for (Eigen::Index p = 0; p < np; ++p) {
@@ -140,7 +144,7 @@ Eigen::Matrix3Xd MessSystem::particle_centres(CentreRule rule) const {
     // The first 8 nodes are the centre voxel's corners (lattice/spheres.hpp).
     const std::size_t count = rule == CentreRule::centre_voxel ? 8 : nodes.size();
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (std::size_t k = 0; k < count; ++k) sum += positions_.col(nodes[k]);
+    for (std::size_t k = 0; k < count; ++k) sum += x.col(nodes[k]);
     c.col(p) = sum / static_cast<double>(count);
   }
   return c;
@@ -223,12 +227,16 @@ void MessSystem::update_magnetization_at(const Eigen::Matrix3Xd& centres) {
 
 template <class F>
 auto MessSystem::with_state(F&& f) const {
-  const Eigen::Matrix3Xd centres = particle_centres();
+  return with_state_at(positions_, std::forward<F>(f));
+}
+
+template <class F>
+auto MessSystem::with_state_at(const Eigen::Matrix3Xd& x, F&& f) const {
+  const Eigen::Matrix3Xd centres = particle_centres_at(x, settings_.centre_rule);
   // One pair list for all pair terms (dipole, WCA), as magnetic_energies() builds it.
   const mm::PairList pairs =
       centres.cols() > 0 ? mm::OpenBoundary{}.pairs(centres) : mm::PairList{};
-  const TermState state{lattice_, positions_,      centres,   M_,
-                        model_,   applied_forces_, settings_, pairs};
+  const TermState state{lattice_, x, centres, M_, model_, applied_forces_, settings_, pairs};
   return f(state);
 }
 
@@ -361,7 +369,16 @@ Eigen::SparseMatrix<double> MessSystem::elastic_hessian() const {
 }
 
 void MessSystem::add_elastic_hessian_blocks(HessianBlockSink& sink) const {
-  with_state([&](const TermState& state) {
+  add_elastic_hessian_blocks(sink, positions_);
+}
+
+void MessSystem::add_elastic_hessian_blocks(HessianBlockSink& sink,
+                                            const Eigen::Matrix3Xd& at) const {
+  if (at.cols() != lattice_.node_count()) {
+    throw std::invalid_argument("MessSystem::add_elastic_hessian_blocks: expected " +
+                                std::to_string(lattice_.node_count()) + " columns");
+  }
+  with_state_at(at, [&](const TermState& state) {
     for (const auto& t : terms_) {
       if (t->in_total() && t->has_hessian_entries()) t->add_hessian_blocks(state, sink);
     }

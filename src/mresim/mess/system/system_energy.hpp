@@ -147,6 +147,8 @@ class MessSystem {
   Eigen::Matrix3Xd particle_centres() const;
   // Either rule, e.g. to compare (or the bounding-box midpoint the original's analysis uses).
   Eigen::Matrix3Xd particle_centres(CentreRule rule) const;
+  // The centres under `rule` at other positions of this lattice (3 x N, m).
+  Eigen::Matrix3Xd particle_centres_at(const Eigen::Matrix3Xd& x, CentreRule rule) const;
   Eigen::Matrix3Xd particle_bounding_box_centres() const;
 
   // Re-solves M now at the current positions from the current M (history).
@@ -184,6 +186,9 @@ class MessSystem {
   Eigen::SparseMatrix<double> elastic_hessian() const;
   // The same Hessian into any sink (e.g. a preallocated pattern, solvers/hessian_assembly.hpp).
   void add_elastic_hessian_blocks(HessianBlockSink& sink) const;
+  // The same at other positions of this lattice (3 x N, m; e.g. where a preconditioner kept
+  // from an earlier state was built). std::invalid_argument if the shape differs.
+  void add_elastic_hessian_blocks(HessianBlockSink& sink, const Eigen::Matrix3Xd& at) const;
   // elastic_hessian() v without assembling it (J/m^2 x m; 3 x N), bitwise independent of the
   // thread count.
   Eigen::Matrix3Xd elastic_hessian_product(const Eigen::Matrix3Xd& v) const;
@@ -204,6 +209,9 @@ class MessSystem {
   // Runs f(state) with the state at the current positions, centres and M.
   template <class F>
   auto with_state(F&& f) const;
+  // The same at positions `x` (3 x N) and their centres.
+  template <class F>
+  auto with_state_at(const Eigen::Matrix3Xd& x, F&& f) const;
 
   lattice::Lattice lattice_;
   magnetism::MagneticModel model_;  // self_energy forced to consistent (4.76)
