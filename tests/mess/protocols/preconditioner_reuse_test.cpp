@@ -15,6 +15,7 @@
 
 #include "../../support/temp_dir.hpp"
 #include "../support/checkpoint_round_trip.hpp"
+#include "../support/small_runs.hpp"
 #include "../support/start_comparison.hpp"
 #include "mresim/mess/protocols/protocol_runner.hpp"
 #include "mresim/mess/solvers/minimiser.hpp"
@@ -25,29 +26,12 @@ namespace {
 // 0, 4, 8 mT along the pair's axis, 7 um apart: the pair moves by about 25 nm per step, less
 // than the default distance of 0.1 lattice spacings (100 nm) from the first step's start.
 std::string large_box_field_steps(double reuse) {
-  return std::string(R"([run]
-type = "mess_hysteresis"
-
-[model]
-profile = "physical"
-discretization_order = 1
-
-[particles]
-placement = "chain"
-count = 2
-separation = 7e-6
-axis = "z"
-
-[box]
-size = [34e-6, 34e-6, 34e-6]
-
-[field]
-max = 0.008
-steps = 2
-sequence = "up"
-
-[solver]
-preconditioner_reuse = )") +
+  std::string model = testing::kSmallModel;
+  const std::string box = "size = [9e-6, 9e-6, 17e-6]";
+  model.replace(model.find(box), box.size(), "size = [34e-6, 34e-6, 34e-6]");
+  return "[run]\ntype = \"mess_hysteresis\"\n" + model +
+         "\n[field]\nmax = 0.008\nsteps = 2\nsequence = \"up\"\n"
+         "\n[solver]\npreconditioner_reuse = " +
          std::to_string(reuse) + "\n";
 }
 
