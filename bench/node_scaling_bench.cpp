@@ -28,6 +28,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -60,6 +61,50 @@ long long kept_steps(const Run& r) {
                        [](const mp::StepRecord& s) { return s.preconditioner == "kept"; });
 }
 
+using Values = std::pair<std::string, std::string>;
+
+// The earlier choice of solver.<key> first, then the default (TOML values); nothing for an
+// unknown key.
+std::optional<Values> values_of(const std::string& key) {
+  if (key == "node_scaling") return Values{"\"diagonal\"", "\"blocks\""};
+  if (key == "contact_gap") return Values{"\"none\"", "\"exact\""};
+  if (key == "preconditioner_reuse") return Values{"0", "0.1"};
+  return std::nullopt;
+}
+
+// The pair's separation (um).
+double separation(const mp::StepRecord& r) {
+  return 1e6 * (r.centres.col(1) - r.centres.col(0)).norm();
+}
+
+// Prints the largest differences between the two runs' states; true if they took identical
+// paths.
+bool print_largest_differences(const Run& earlier, const Run& chosen) {
+  double centres = 0.0;
+  double separations = 0.0;
+  double magnetization = 0.0;
+  double energy = 0.0;
+  bool identical = true;
+  for (std::size_t i = 0; i < earlier.records.size(); ++i) {
+    const mp::StepRecord& a = earlier.records[i];
+    const mp::StepRecord& b = chosen.records[i];
+    centres = std::max(centres, (a.centres - b.centres).cwiseAbs().maxCoeff());
+    separations = std::max(separations, std::abs(separation(a) - separation(b)) * 1e-6);
+    magnetization =
+        std::max(magnetization, (a.magnetization - b.magnetization).cwiseAbs().maxCoeff());
+    if (std::abs(a.energies.total()) > 0.0) {
+      energy = std::max(
+          energy, std::abs(a.energies.total() - b.energies.total()) / std::abs(a.energies.total()));
+    }
+    identical = identical && a.iterations == b.iterations && a.centres == b.centres;
+  }
+  std::printf(
+      "  largest differences: centres %.2e m, separations %.2e m, M %.2e A/m, total energy %.2e "
+      "relative\n",
+      centres, separations, magnetization, energy);
+  return identical;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -73,20 +118,13 @@ int main(int argc, char** argv) {
       rest.push_back(argv[k]);
     }
   }
-  // The earlier choice first, then the default (TOML values).
-  using Values = std::pair<std::string, std::string>;
-  Values values;
-  if (key == "node_scaling") {
-    values = {"\"diagonal\"", "\"blocks\""};
-  } else if (key == "contact_gap") {
-    values = {"\"none\"", "\"exact\""};
-  } else if (key == "preconditioner_reuse") {
-    values = {"0", "0.1"};
-  } else {
+  const std::optional<Values> chosen_values = values_of(key);
+  if (!chosen_values) {
     std::fprintf(stderr, "--compare %s: one of node_scaling, contact_gap, preconditioner_reuse\n",
                  key.c_str());
     return 2;
   }
+  const Values& values = *chosen_values;
   Values labels = values;  // for the table: without the quotes
   std::erase(labels.first, '"');
   std::erase(labels.second, '"');
@@ -119,9 +157,6 @@ int main(int argc, char** argv) {
     const Eigen::Vector3d d = r.centres.col(1) - r.centres.col(0);
     return std::acos(std::min(1.0, std::abs(d.z()) / d.norm())) * 180.0 / M_PI;
   };
-  const auto separation = [](const mp::StepRecord& r) {
-    return 1e6 * (r.centres.col(1) - r.centres.col(0)).norm();
-  };
   for (std::size_t i = 0; i < earlier.records.size(); ++i) {
     const mp::StepRecord& a = earlier.records[i];
     const mp::StepRecord& b = chosen.records[i];
@@ -147,28 +182,7 @@ int main(int argc, char** argv) {
               static_cast<double>(earlier.evaluations) / static_cast<double>(chosen.evaluations),
               earlier.cpu / chosen.cpu);
 
-  double centres = 0.0;
-  double separations = 0.0;
-  double magnetization = 0.0;
-  double energy = 0.0;
-  bool identical = true;
-  for (std::size_t i = 0; i < earlier.records.size(); ++i) {
-    const mp::StepRecord& a = earlier.records[i];
-    const mp::StepRecord& b = chosen.records[i];
-    centres = std::max(centres, (a.centres - b.centres).cwiseAbs().maxCoeff());
-    separations = std::max(separations, std::abs(separation(a) - separation(b)) * 1e-6);
-    magnetization =
-        std::max(magnetization, (a.magnetization - b.magnetization).cwiseAbs().maxCoeff());
-    if (std::abs(a.energies.total()) > 0.0) {
-      energy = std::max(
-          energy, std::abs(a.energies.total() - b.energies.total()) / std::abs(a.energies.total()));
-    }
-    identical = identical && a.iterations == b.iterations && a.centres == b.centres;
-  }
-  std::printf(
-      "  largest differences: centres %.2e m, separations %.2e m, M %.2e A/m, total energy %.2e "
-      "relative\n",
-      centres, separations, magnetization, energy);
+  const bool identical = print_largest_differences(earlier, chosen);
   if (identical) {
     std::fprintf(stderr, "the two choices took identical paths: the setting had no effect\n");
     return 1;

@@ -204,6 +204,35 @@ std::string ProtocolRunner::predict_start(const StepSpec& step, const ProtocolSt
   return take_if_not_higher(system_, candidate) ? kind : step_start::kPredictionRejected;
 }
 
+namespace {
+
+// The state's preconditioner anchor (a resumed or extended run's) goes to the cache, and the
+// state lets go of it while the step relaxes, so that a new anchor never waits beside it.
+void hand_anchor_to_cache(ProtocolState& state, const lattice::Lattice& lat,
+                          mess::PreconditionerCache& cache) {
+  if (state.preconditioner_anchor != cache.anchor()) {
+    cache.restore(lat, state.preconditioner_anchor);
+  }
+  state.preconditioner_anchor.reset();
+}
+
+// The step's magnetization solves (since `before`) and its final solve; a step converges only
+// if that solve did.
+void record_magnetization(const mess::MessSystem& system, const mess::MagnetizationStats& before,
+                          StepRecord& record) {
+  const mess::MagnetizationStats& after = system.magnetization_stats();
+  record.magnetization_solves = after.solves - before.solves;
+  record.unconverged_magnetization_solves = after.unconverged - before.unconverged;
+  // Without particles no magnetization is solved (MessSystem skips it): "none".
+  record.magnetization_method =
+      system.particle_count() == 0 ? "none" : mm::to_string(after.last.method);
+  record.magnetization_iterations = after.last.total_iterations;
+  record.magnetization_residual = after.last.residual;
+  record.converged = record.converged && (system.particle_count() == 0 || after.last.converged);
+}
+
+}  // namespace
+
 const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   if (state.next_step >= steps_.size()) {
     throw std::logic_error("ProtocolRunner::run_next_step: no steps left");
@@ -211,12 +240,7 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   const auto started = std::chrono::steady_clock::now();
   const StepSpec& step = steps_[state.next_step];
   const lattice::Lattice& lat = system_.lattice();
-  // The state's preconditioner anchor (a resumed or extended run's) goes to the cache, and the
-  // state lets go of it while the step relaxes, so that a new anchor never waits beside it.
-  if (state.preconditioner_anchor != preconditioner_cache_->anchor()) {
-    preconditioner_cache_->restore(lat, state.preconditioner_anchor);
-  }
-  state.preconditioner_anchor.reset();
+  hand_anchor_to_cache(state, lat, *preconditioner_cache_);
 
   // Boundary conditions (the protocol's): loaded steps of a protocol that says so are measured
   // from the zero-load state at this field.
@@ -279,15 +303,7 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
     record.energies = r.final.energies;
   }
 
-  const mess::MagnetizationStats& after = system_.magnetization_stats();
-  record.magnetization_solves = after.solves - before.solves;
-  record.unconverged_magnetization_solves = after.unconverged - before.unconverged;
-  // Without particles no magnetization is solved (MessSystem skips it): "none".
-  record.magnetization_method =
-      system_.particle_count() == 0 ? "none" : mm::to_string(after.last.method);
-  record.magnetization_iterations = after.last.total_iterations;
-  record.magnetization_residual = after.last.residual;
-  record.converged = record.converged && (system_.particle_count() == 0 || after.last.converged);
+  record_magnetization(system_, before, record);
 
   record.centres = system_.particle_centres();
   record.magnetization = system_.magnetizations();
