@@ -51,6 +51,20 @@ std::vector<std::string> string_column(const std::vector<StepRecord>& records,
   return out;
 }
 
+// A column that older files lack: `fallback` for each of the n steps where it is absent.
+std::vector<std::string> strings_or(const io::Hdf5Reader& file, const std::string& path,
+                                    std::size_t n, const std::string& fallback = "unrecorded") {
+  return file.exists(path) ? file.strings(path) : std::vector<std::string>(n, fallback);
+}
+
+std::vector<std::int64_t> ints_or(const io::Hdf5Reader& file, const std::string& path,
+                                  std::size_t n, std::int64_t fallback) {
+  if (!file.exists(path)) return std::vector<std::int64_t>(n, fallback);
+  std::vector<std::int64_t> v = file.ints(path);
+  if (v.size() != n) throw std::runtime_error("inconsistent length of " + path);
+  return v;
+}
+
 // steps x particles x 3 from each record's 3 x N_p matrix.
 std::vector<double> stacked(const std::vector<StepRecord>& records,
                             const Eigen::Matrix3Xd StepRecord::*member) {
@@ -188,26 +202,13 @@ std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std:
   const std::vector<std::string> status = file.strings(s + "status");
   const std::vector<std::int64_t> iterations = ints(s + "iterations");
   const std::vector<std::int64_t> evaluations = ints(s + "evaluations");
-  // Absent in files written before the CG counts were recorded: zero.
-  const std::vector<std::int64_t> krylov = file.exists(s + "krylov_iterations")
-                                               ? ints(s + "krylov_iterations")
-                                               : std::vector<std::int64_t>(n, 0);
-  // Absent in files written before the finishing method was recorded: "unrecorded", 0.
-  const std::vector<std::string> finished_by = file.exists(s + "finished_by")
-                                                   ? file.strings(s + "finished_by")
-                                                   : std::vector<std::string>(n, "unrecorded");
-  // Absent in files written before the start was recorded: "unrecorded".
-  const std::vector<std::string> start = file.exists(s + "start")
-                                             ? file.strings(s + "start")
-                                             : std::vector<std::string>(n, "unrecorded");
-  // Absent in files written before it was recorded: "unrecorded" (such runs built the
-  // multilevel preconditioner at every step's start).
-  const std::vector<std::string> preconditioner = file.exists(s + "preconditioner")
-                                                      ? file.strings(s + "preconditioner")
-                                                      : std::vector<std::string>(n, "unrecorded");
-  const std::vector<std::int64_t> passes = file.exists(s + "correction_passes")
-                                               ? ints(s + "correction_passes")
-                                               : std::vector<std::int64_t>(n, 0);
+  // Absent in files written before these were recorded: 0 or "unrecorded" (for the
+  // preconditioner, such runs built the multilevel one at every step's start).
+  const std::vector<std::int64_t> krylov = ints_or(file, s + "krylov_iterations", n, 0);
+  const std::vector<std::string> finished_by = strings_or(file, s + "finished_by", n);
+  const std::vector<std::string> start = strings_or(file, s + "start", n);
+  const std::vector<std::string> preconditioner = strings_or(file, s + "preconditioner", n);
+  const std::vector<std::int64_t> passes = ints_or(file, s + "correction_passes", n, 0);
   const std::vector<double> max_force = doubles(s + "max_force");
   const std::vector<std::int64_t> solves = ints(s + "magnetization_solves");
   const std::vector<std::int64_t> unconverged = ints(s + "unconverged_magnetization_solves");
@@ -216,9 +217,7 @@ std::vector<StepRecord> read_step_records(const io::Hdf5Reader& file, const std:
   const std::vector<double> m_residual = doubles(s + "magnetization_residual");
   const std::vector<double> wall = doubles(s + "wall_time");
   // Absent in files written before the peak memory was recorded per step: 0.
-  const std::vector<std::int64_t> peak_memory = file.exists(s + "peak_resident_memory")
-                                                    ? ints(s + "peak_resident_memory")
-                                                    : std::vector<std::int64_t>(n, 0);
+  const std::vector<std::int64_t> peak_memory = ints_or(file, s + "peak_resident_memory", n, 0);
   if (status.size() != n || method.size() != n || finished_by.size() != n || start.size() != n ||
       preconditioner.size() != n) {
     throw std::runtime_error("inconsistent solver data in " + group);
