@@ -59,8 +59,9 @@ std::vector<std::string> strings_or(const io::Hdf5Reader& file, const std::strin
 
 std::vector<std::int64_t> ints_or(const io::Hdf5Reader& file, const std::string& path,
                                   std::size_t n, std::int64_t fallback) {
-  if (!file.exists(path)) return std::vector<std::int64_t>(n, fallback);
-  std::vector<std::int64_t> v = file.ints(path);
+  std::vector<std::int64_t> v(n, fallback);
+  if (!file.exists(path)) return v;
+  v = file.ints(path);
   if (v.size() != n) throw std::runtime_error("inconsistent length of " + path);
   return v;
 }
