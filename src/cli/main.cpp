@@ -11,6 +11,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/exit_status.hpp"
+#include "mresim/app/allocator_arenas.hpp"
 #include "mresim/app/command_line.hpp"
 #include "mresim/app/run_output.hpp"
 #include "mresim/app/stop_signal.hpp"
@@ -119,6 +120,9 @@ int run_cli(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Before any thread allocates (allocator_arenas.hpp): memory freed in a worker thread then
+  // serves the next allocation instead of staying resident in that thread's arena.
+  (void)mresim::app::use_one_allocator_arena();
   try {
     return run_cli(argc, argv);
   } catch (const std::exception& e) {  // e.g. out of memory while setting up
