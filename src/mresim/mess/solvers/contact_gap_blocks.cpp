@@ -135,6 +135,7 @@ ContactGapBlocks::ContactGapBlocks(const MessSystem& system, const DofMap& map, 
       ++left_out_;  // not positive definite (header)
       continue;
     }
+    gap.solves = detail::SplitCholeskySolve(gap.factor->matrixL().nestedExpression());
     gaps_.push_back(std::move(gap));
   }
 }
@@ -144,27 +145,11 @@ void ContactGapBlocks::add_to(const Eigen::VectorXd& v, Eigen::VectorXd& w) cons
     // H_g^-1 = P^T L^-T L^-1 P with the factor's L (single precision, its diagonal first in
     // each column) and fill-reducing permutation P; the solves in double, so that the operator
     // is symmetric to double rounding.
-    const Eigen::SparseMatrix<float>& lower = gap.factor->matrixL().nestedExpression();
     const auto size = static_cast<Eigen::Index>(gap.dofs.size());
     Eigen::VectorXd r(size);
     for (Eigen::Index k = 0; k < size; ++k) r[k] = v[gap.dofs[static_cast<std::size_t>(k)]];
     Eigen::VectorXd y = gap.factor->permutationP() * r;
-    const int* start = lower.outerIndexPtr();
-    const int* row = lower.innerIndexPtr();
-    const float* value = lower.valuePtr();
-    for (Eigen::Index j = 0; j < size; ++j) {  // L y' = y
-      y[j] /= static_cast<double>(value[start[j]]);
-      for (int e = start[j] + 1; e < start[j + 1]; ++e) {
-        y[row[e]] -= static_cast<double>(value[e]) * y[j];
-      }
-    }
-    for (Eigen::Index j = size - 1; j >= 0; --j) {  // L^T x = y'
-      double sum = y[j];
-      for (int e = start[j] + 1; e < start[j + 1]; ++e) {
-        sum -= static_cast<double>(value[e]) * y[row[e]];
-      }
-      y[j] = sum / static_cast<double>(value[start[j]]);
-    }
+    gap.solves.solve(gap.factor->matrixL().nestedExpression(), y);
     const Eigen::VectorXd x = gap.factor->permutationP().transpose() * y;
     for (Eigen::Index k = 0; k < size; ++k) w[gap.dofs[static_cast<std::size_t>(k)]] += x[k];
   }

@@ -35,7 +35,9 @@
 // precision: on the full-size Fig. 4.11 lattice in contact 6,951 coordinates and 2.46 million
 // entries of L, 20 MB (69 bytes per lattice node; 30 MB in double). Applying it is a forward
 // and a back substitution through L in double precision (so the operator is symmetric to double
-// rounding), serial, so the result does not depend on the number of threads.
+// rounding), each split into two branches of the factor's elimination tree that two threads
+// solve at once and a trunk solved after (forward) or before (backward) them
+// (split_cholesky_solve.hpp); the result does not depend on the number of threads.
 
 #include <Eigen/Core>
 #include <Eigen/SparseCholesky>
@@ -46,6 +48,7 @@
 #include <utility>
 #include <vector>
 
+#include "mresim/mess/solvers/split_cholesky_solve.hpp"
 #include "mresim/mess/system/constraints.hpp"
 #include "mresim/mess/system/system_energy.hpp"
 
@@ -75,11 +78,20 @@ class ContactGapBlocks {
   [[nodiscard]] Eigen::Index dofs() const;
   // Gaps found but left out (their block not positive definite).
   [[nodiscard]] int left_out() const { return left_out_; }
+  // Gap g's factor and the split of its solves (tests and bench/contact_gap_bench.cpp).
+  [[nodiscard]] const Eigen::SimplicialLLT<Eigen::SparseMatrix<float>>& factor(
+      std::size_t g) const {
+    return *gaps_.at(g).factor;
+  }
+  [[nodiscard]] const detail::SplitCholeskySolve& solves(std::size_t g) const {
+    return gaps_.at(g).solves;
+  }
 
  private:
   struct Gap {
     std::vector<Eigen::Index> dofs;  // the map's dof of each local coordinate
     std::unique_ptr<Eigen::SimplicialLLT<Eigen::SparseMatrix<float>>> factor;
+    detail::SplitCholeskySolve solves;  // the factor's solves on two threads
   };
   // The polymer nodes of the gap between particles centred at `first` and `second` (header),
   // at positions `x`.
