@@ -30,27 +30,6 @@ namespace {
 namespace mess = mresim::mess;
 using mresim::bench::best_seconds;
 
-// The plain substitutions through L (column by column), as the gap was solved before the split.
-void serial_solve(const Eigen::SparseMatrix<float>& lower, Eigen::VectorXd& y) {
-  const int* start = lower.outerIndexPtr();
-  const int* row = lower.innerIndexPtr();
-  const float* value = lower.valuePtr();
-  const auto n = static_cast<int>(lower.cols());
-  for (int j = 0; j < n; ++j) {
-    y[j] /= static_cast<double>(value[start[j]]);
-    for (int e = start[j] + 1; e < start[j + 1]; ++e) {
-      y[row[e]] -= static_cast<double>(value[e]) * y[j];
-    }
-  }
-  for (int j = n - 1; j >= 0; --j) {
-    double sum = y[j];
-    for (int e = start[j] + 1; e < start[j + 1]; ++e) {
-      sum -= static_cast<double>(value[e]) * y[row[e]];
-    }
-    y[j] = sum / static_cast<double>(value[start[j]]);
-  }
-}
-
 std::string pair_in_contact_run_file() {
   const std::string path =
       std::string(MRESIM_SOURCE_DIR) + "/examples/chapter4/fig4_11_pair_large_box_S6_5um.toml";
@@ -78,14 +57,7 @@ int main(int argc, char** argv) {
       mresim::config::TableReader::parse_string(pair_in_contact_run_file(), "fig4_11 in contact"));
   const mresim::mess_protocol::ProtocolRunner runner(spec);
   mess::MessSystem system = runner.system();
-  const Eigen::Matrix3Xd x = system.positions();
-  mess::BoundaryConstraints held = mess::BoundaryConstraints::none(system.node_count());
-  for (const auto face :
-       {mresim::lattice::Face::left, mresim::lattice::Face::right, mresim::lattice::Face::front,
-        mresim::lattice::Face::back, mresim::lattice::Face::bottom, mresim::lattice::Face::top}) {
-    held.fix_face(system.lattice().shape, face, x);
-  }
-  system.set_constraints(std::move(held));
+  mresim::bench::hold_all_faces(system);
   system.apply_constraints();
   const mess::DofMap map(system.constraints(), system.positions(), system.length_scale());
   const mess::ContactGapBlocks gaps(system, map, 1e-9, system.positions());
@@ -111,7 +83,7 @@ int main(int argc, char** argv) {
   Eigen::VectorXd y;
   const double t_serial = best_seconds(options->repeats, [&] {
     serial = b;
-    serial_solve(lower, serial);
+    mess::detail::serial_cholesky_solve(lower, serial);
   });
   Eigen::VectorXd one;
   double t_one = 0.0;

@@ -13,6 +13,7 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <utility>
 
 #include "mresim/config/table_reader.hpp"
 #include "mresim/mess/run_file/mess_spec.hpp"
@@ -59,6 +60,18 @@ inline void displace_at_random(mess::MessSystem& system, std::mt19937_64& random
     for (int a = 0; a < 3; ++a) x(a, n) += jitter(random) * system.length_scale();
   }
   system.set_positions(x);
+}
+
+// All six faces of the lattice held where the nodes are now, as the hysteresis runs of Chapter 4
+// hold them.
+inline void hold_all_faces(mess::MessSystem& system) {
+  const Eigen::Matrix3Xd x = system.positions();
+  mess::BoundaryConstraints held = mess::BoundaryConstraints::none(system.node_count());
+  for (const auto face : {lattice::Face::left, lattice::Face::right, lattice::Face::front,
+                          lattice::Face::back, lattice::Face::bottom, lattice::Face::top}) {
+    held.fix_face(system.lattice().shape, face, x);
+  }
+  system.set_constraints(std::move(held));
 }
 
 inline double seconds_since(std::chrono::steady_clock::time_point start) {

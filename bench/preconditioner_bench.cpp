@@ -72,14 +72,7 @@ void run_system(const SystemFile& file, int repeats) {
   std::mt19937_64 random(20261205);
   mresim::bench::displace_at_random(system, random);
   const Eigen::Matrix3Xd& x = system.positions();
-  // All six faces held, as the hysteresis runs of Chapter 4 hold them.
-  mess::BoundaryConstraints held = mess::BoundaryConstraints::none(nodes);
-  for (const auto face :
-       {mresim::lattice::Face::left, mresim::lattice::Face::right, mresim::lattice::Face::front,
-        mresim::lattice::Face::back, mresim::lattice::Face::bottom, mresim::lattice::Face::top}) {
-    held.fix_face(system.lattice().shape, face, x);
-  }
-  system.set_constraints(std::move(held));
+  mresim::bench::hold_all_faces(system);  // as the hysteresis runs of Chapter 4 hold them
   system.apply_constraints();
   const double l_e = system.length_scale();
   const mess::DofMap map(system.constraints(), system.positions(), l_e);

@@ -11,13 +11,16 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <cstdlib>
-#include <random>
 #include <vector>
+
+#include "../support/multilevel_test_support.hpp"
 
 namespace {
 
 using Factor = Eigen::SimplicialLLT<Eigen::SparseMatrix<float>>;
+using mresim::mess::detail::serial_cholesky_solve;
 using mresim::mess::detail::SplitCholeskySolve;
+using mresim::mess::testing::uniform_random_vector;
 
 // A 27-point stencil on an n x n x n grid (each node coupled to its 26 neighbours with -1, its
 // diagonal 27): symmetric positive definite, and its factor fills in as the gap's block does.
@@ -55,35 +58,6 @@ Eigen::SparseMatrix<float> grid_matrix(int n, int blocks = 1) {
   return a;
 }
 
-Eigen::VectorXd random_vector(Eigen::Index size, unsigned seed) {
-  std::mt19937_64 random(seed);
-  std::normal_distribution<double> normal;
-  Eigen::VectorXd v(size);
-  for (Eigen::Index k = 0; k < size; ++k) v[k] = normal(random);
-  return v;
-}
-
-// The plain forward and back substitution through L, column by column (the reference).
-void substitute(const Eigen::SparseMatrix<float>& lower, Eigen::VectorXd& y) {
-  const int* start = lower.outerIndexPtr();
-  const int* row = lower.innerIndexPtr();
-  const float* value = lower.valuePtr();
-  const auto n = static_cast<int>(lower.cols());
-  for (int j = 0; j < n; ++j) {
-    y[j] /= static_cast<double>(value[start[j]]);
-    for (int e = start[j] + 1; e < start[j + 1]; ++e) {
-      y[row[e]] -= static_cast<double>(value[e]) * y[j];
-    }
-  }
-  for (int j = n - 1; j >= 0; --j) {
-    double sum = y[j];
-    for (int e = start[j] + 1; e < start[j + 1]; ++e) {
-      sum -= static_cast<double>(value[e]) * y[row[e]];
-    }
-    y[j] = sum / static_cast<double>(value[start[j]]);
-  }
-}
-
 // Solves with `threads` threads, the number restored afterwards.
 Eigen::VectorXd solve_with(const SplitCholeskySolve& split, const Eigen::SparseMatrix<float>& lower,
                            const Eigen::VectorXd& b, int threads) {
@@ -111,9 +85,9 @@ TEST(SplitCholeskySolve, SolvesAsTheSubstitutionDoesAndSplitsEveryEntry) {
   EXPECT_LT(split.trunk_entries(), lower.nonZeros() / 2);
   EXPECT_LT(std::abs(branch[0] - branch[1]), (branch[0] + branch[1]) / 5);
 
-  const Eigen::VectorXd b = random_vector(a.rows(), 7);
+  const Eigen::VectorXd b = uniform_random_vector(a.rows(), 7);
   Eigen::VectorXd reference = factor.permutationP() * b;
-  substitute(lower, reference);
+  serial_cholesky_solve(lower, reference);
   const Eigen::VectorXd permuted = factor.permutationP() * b;
   const Eigen::VectorXd one = solve_with(split, lower, permuted, 1);
   const Eigen::VectorXd two = solve_with(split, lower, permuted, 2);
@@ -134,9 +108,9 @@ TEST(SplitCholeskySolve, TwoUncoupledBlocksAreTwoBranchesWithoutATrunk) {
   EXPECT_EQ(split.trunk_entries(), 0);
   const auto& branch = split.branch_entries();
   EXPECT_LT(std::abs(branch[0] - branch[1]), (branch[0] + branch[1]) / 10);
-  const Eigen::VectorXd b = random_vector(a.rows(), 8);
+  const Eigen::VectorXd b = uniform_random_vector(a.rows(), 8);
   Eigen::VectorXd reference = b;
-  substitute(lower, reference);
+  serial_cholesky_solve(lower, reference);
   // Without a trunk no sum changes its order: bitwise the plain substitution.
   EXPECT_TRUE(solve_with(split, lower, b, 2) == reference);
   EXPECT_TRUE(solve_with(split, lower, b, 1) == reference);
@@ -151,9 +125,9 @@ TEST(SplitCholeskySolve, ASmallFactorStaysWholeInTheTrunk) {
   const SplitCholeskySolve split(lower);
   EXPECT_EQ(split.trunk_entries(), lower.nonZeros());
   EXPECT_EQ(split.branch_entries()[0] + split.branch_entries()[1], 0);
-  const Eigen::VectorXd b = random_vector(a.rows(), 9);
+  const Eigen::VectorXd b = uniform_random_vector(a.rows(), 9);
   Eigen::VectorXd reference = b;
-  substitute(lower, reference);
+  serial_cholesky_solve(lower, reference);
   EXPECT_TRUE(solve_with(split, lower, b, 2) == reference);
 }
 

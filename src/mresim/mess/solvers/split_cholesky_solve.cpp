@@ -245,4 +245,24 @@ void SplitCholeskySolve::solve(const Eigen::SparseMatrix<float>& lower, Eigen::V
   }
 }
 
+void serial_cholesky_solve(const Eigen::SparseMatrix<float>& lower, Eigen::VectorXd& y) {
+  const int* start = lower.outerIndexPtr();
+  const int* row = lower.innerIndexPtr();
+  const float* value = lower.valuePtr();
+  const auto n = static_cast<int>(lower.cols());
+  for (int j = 0; j < n; ++j) {
+    y[j] /= static_cast<double>(value[start[j]]);
+    for (int e = start[j] + 1; e < start[j + 1]; ++e) {
+      y[row[e]] -= static_cast<double>(value[e]) * y[j];
+    }
+  }
+  for (int j = n - 1; j >= 0; --j) {
+    double sum = y[j];
+    for (int e = start[j] + 1; e < start[j + 1]; ++e) {
+      sum -= static_cast<double>(value[e]) * y[row[e]];
+    }
+    y[j] = sum / static_cast<double>(value[start[j]]);
+  }
+}
+
 }  // namespace mresim::mess::detail

@@ -54,4 +54,8 @@ class SplitCholeskySolve {
   long trunk_entries_ = 0;
 };
 
+// The plain forward and back substitution through `lower` (column by column, one thread): y <-
+// (L L^T)^-1 y. The reference the split is measured and tested against.
+void serial_cholesky_solve(const Eigen::SparseMatrix<float>& lower, Eigen::VectorXd& y);
+
 }  // namespace mresim::mess::detail
