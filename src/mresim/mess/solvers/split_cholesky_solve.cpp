@@ -237,11 +237,11 @@ void SplitCholeskySolve::solve(const Eigen::SparseMatrix<float>& lower, Eigen::V
     }
     x[j] = sum / static_cast<double>(value[start[j]]);
   };
-  for (auto j = trunk_columns_.rbegin(); j != trunk_columns_.rend(); ++j) gather(*j);
+  for (std::size_t k = trunk_columns_.size(); k-- > 0;) gather(trunk_columns_[k]);
 #pragma omp parallel for schedule(static, 1) if (both)
   for (int b = 0; b < 2; ++b) {
     const std::vector<int>& columns = branch_columns_[static_cast<std::size_t>(b)];
-    for (auto j = columns.rbegin(); j != columns.rend(); ++j) gather(*j);
+    for (std::size_t k = columns.size(); k-- > 0;) gather(columns[k]);
   }
 }
 
