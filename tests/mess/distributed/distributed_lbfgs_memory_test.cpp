@@ -1,9 +1,9 @@
 // L-BFGS's memory split over MPI processes (LbfgsMemory::set_split, MpiBlockSplit, docs/mpi.md):
-// each process stores only its own blocks of the pairs, and the two-loop product is still
-// bitwise the single-process one on every process. Vectors of several kSumBlock blocks with a
-// short last block, and a preconditioner that mixes entries of different processes' blocks. Run
-// on one process by ctest and on two and three in mess_distributed_two_ranks/_three_ranks,
-// where with three processes one owns a single block.
+// each process stores only its own blocks of the pairs, and the product is still bitwise the
+// single-process one on every process, in L-BFGS's order of products and adds and out of it.
+// Vectors of several kSumBlock blocks with a short last block, and a preconditioner that mixes
+// entries of different processes' blocks. Run on one process by ctest and on two and three in
+// mess_distributed_two_ranks/_three_ranks, where with three processes one owns a single block.
 
 #include <gtest/gtest.h>
 
@@ -58,30 +58,43 @@ void expect_split_product_is_the_whole_one(mess::detail::LbfgsPrecision precisio
   split.set_precision(precision);
   split.set_split(std::make_shared<mess::MpiBlockSplit>(MPI_COMM_WORLD));
   constexpr int kCapacity = 3;
+  // L-BFGS's order (each pair's P y from two products' P g) and, every other pair, a product
+  // at another point (the pair's P y formed by applying P to its y, which each process holds
+  // only in part).
   Eigen::VectorXd g_old = random_vector(n, rng);
-  for (int pair = 0; pair < 5; ++pair) {  // more pairs than the capacity: storage is reused
+  ASSERT_TRUE(everywhere(split.times(g_old, P) == whole.times(g_old, P)));
+  for (int pair = 0; pair < 6; ++pair) {  // more pairs than the capacity: storage is reused
     const Eigen::VectorXd d = random_vector(n, rng);
     const double alpha = 0.5 + 0.1 * pair;
     const Eigen::VectorXd g_new = g_old + curvature.cwiseProduct(alpha * d);
     whole.add(alpha, d, g_new, g_old, kCapacity);
     split.add(alpha, d, g_new, g_old, kCapacity);
     ASSERT_TRUE(everywhere(whole.size() == split.size()));
-    const Eigen::VectorXd g = random_vector(n, rng);
+    const Eigen::VectorXd g = pair % 2 == 0 ? g_new : Eigen::VectorXd(random_vector(n, rng));
     const Eigen::VectorXd expected = whole.times(g, P);
     const Eigen::VectorXd product = split.times(g, P);
     EXPECT_TRUE(everywhere(product == expected))
         << "pair " << pair << ": largest difference " << (product - expected).cwiseAbs().maxCoeff();
-    g_old = g_new;
+    g_old = g;
   }
   EXPECT_EQ(whole.size(), kCapacity);
 
-  // After forget_scale() (a new preconditioner) H0's scale is formed again from the newest
-  // pair, whose y each process holds only in part.
+  // After preconditioner_changed() (a new preconditioner) the pairs are gone and the product
+  // is P g on every process.
   const LbfgsMemory::Preconditioner P2 = mixing_preconditioner(2.0 * w);
-  whole.forget_scale();
-  split.forget_scale();
+  whole.preconditioner_changed();
+  split.preconditioner_changed();
   const Eigen::VectorXd g = random_vector(n, rng);
-  EXPECT_TRUE(everywhere(split.times(g, P2) == whole.times(g, P2)));
+  EXPECT_TRUE(everywhere(split.times(g, P2) == P2(g)));
+  EXPECT_TRUE(everywhere(whole.times(g, P2) == P2(g)));
+  // Pairs again, for the stored entries below.
+  for (int pair = 0; pair < kCapacity; ++pair) {
+    const Eigen::VectorXd d = random_vector(n, rng);
+    const Eigen::VectorXd g_new = g_old + curvature.cwiseProduct(d);
+    whole.add(1.0, d, g_new, g_old, kCapacity);
+    split.add(1.0, d, g_new, g_old, kCapacity);
+    g_old = g_new;
+  }
 
   // Each process stores only its blocks: together exactly the whole memory once.
   long long mine = split.stored_entries();
@@ -94,7 +107,7 @@ void expect_split_product_is_the_whole_one(mess::detail::LbfgsPrecision precisio
   }
 }
 
-TEST(DistributedLbfgsMemory, TwoLoopProductIsBitwiseTheSingleProcessOne) {
+TEST(DistributedLbfgsMemory, ProductIsBitwiseTheSingleProcessOne) {
   expect_split_product_is_the_whole_one(mess::detail::LbfgsPrecision::double_precision);
   expect_split_product_is_the_whole_one(mess::detail::LbfgsPrecision::single_precision);
 }

@@ -1,14 +1,16 @@
-// The L-BFGS memory (lbfgs_memory.hpp): its blocked, fused two-loop recursion gives the product
-// of the textbook serial recursion (to rounding), bitwise the same for any number of threads;
-// pairs without positive curvature are refused, the oldest pair goes beyond the capacity, and
-// H0's scale costs one preconditioner application per new pair. Pairs stored in single
-// precision give the recursion of the rounded pairs.
+// The L-BFGS memory (lbfgs_memory.hpp): its compact-form product gives the product of the
+// textbook two-loop recursion (to rounding), bitwise the same for any number of threads, with
+// one application of the preconditioner per product when taken in L-BFGS's order (the newest
+// pair's P y from the difference of two products' P g) and one more per pair otherwise. Pairs
+// without positive curvature are refused, the oldest pair goes beyond the capacity. Pairs
+// stored in single precision give the product to single rounding.
 
 #include "mresim/mess/solvers/lbfgs_memory.hpp"
 
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -29,9 +31,14 @@ struct Pair {
   Eigen::VectorXd y;
 };
 
+// P v = w .* v + 0.3 (v reversed): symmetric positive definite (w >= 1) and not diagonal.
+Eigen::VectorXd mixing(const Eigen::VectorXd& w, const Eigen::VectorXd& v) {
+  return w.cwiseProduct(v) + 0.3 * v.reverse();
+}
+
 // N&W Alg. 7.4 with Eigen's serial algebra, H0 = (s.y / y.P y) P of the newest pair.
 Eigen::VectorXd serial_two_loop(const std::vector<Pair>& pairs, const Eigen::VectorXd& g,
-                                const Eigen::VectorXd& p_diagonal) {
+                                const Eigen::VectorXd& w) {
   Eigen::VectorXd q = g;
   std::vector<double> a(pairs.size());
   for (int k = static_cast<int>(pairs.size()) - 1; k >= 0; --k) {
@@ -40,8 +47,7 @@ Eigen::VectorXd serial_two_loop(const std::vector<Pair>& pairs, const Eigen::Vec
     q -= a[static_cast<std::size_t>(k)] * p.y;
   }
   const Pair& newest = pairs.back();
-  q = p_diagonal.cwiseProduct(q) *
-      (newest.s.dot(newest.y) / newest.y.dot(p_diagonal.cwiseProduct(newest.y)));
+  q = mixing(w, q) * (newest.s.dot(newest.y) / newest.y.dot(mixing(w, newest.y)));
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const double b = pairs[k].y.dot(q) / pairs[k].s.dot(pairs[k].y);
     q += (a[k] - b) * pairs[k].s;
@@ -50,14 +56,15 @@ Eigen::VectorXd serial_two_loop(const std::vector<Pair>& pairs, const Eigen::Vec
 }
 
 // A memory of `count` pairs with y = A s for a diagonal A > 0 (positive curvature), over n
-// unknowns, the pairs added as L-BFGS adds them (s = alpha d, y = g_new - g_old).
+// unknowns, the pairs added as L-BFGS adds them (s = alpha d, y = g_new - g_old) but with no
+// product between them, so that each pair's P y is formed by applying P.
 struct Fixture {
   explicit Fixture(Eigen::Index n, int count, int capacity,
                    LbfgsPrecision precision = LbfgsPrecision::double_precision)
       : random(7) {
     memory.set_precision(precision);
-    const Eigen::VectorXd curvature = random_vector(n, random).cwiseAbs().array() + 0.5;
-    p_diagonal = curvature.cwiseInverse();
+    curvature = random_vector(n, random).cwiseAbs().array() + 0.5;
+    w = random_vector(n, random).cwiseAbs().array() + 1.0;
     for (int k = 0; k < count; ++k) {
       const Eigen::VectorXd d = random_vector(n, random);
       const double alpha = 0.5 + 0.1 * k;
@@ -67,29 +74,42 @@ struct Fixture {
       pairs.push_back({alpha * d, g_new - g_old});
     }
     while (static_cast<int>(pairs.size()) > capacity) pairs.erase(pairs.begin());
-    preconditioner = [this](const Eigen::VectorXd& v) -> Eigen::VectorXd {
-      ++applications;
-      return p_diagonal.cwiseProduct(v);
+    preconditioner = [w = w, count = applications](const Eigen::VectorXd& v) -> Eigen::VectorXd {
+      ++*count;
+      return mixing(w, v);
     };
   }
+  Fixture(const Fixture&) = delete;
+  Fixture& operator=(const Fixture&) = delete;
+  Fixture(Fixture&&) = delete;
+  Fixture& operator=(Fixture&&) = delete;
+  ~Fixture() = default;
+  [[nodiscard]] int applied() const { return *applications; }
   std::mt19937_64 random;
-  Eigen::VectorXd p_diagonal;
+  Eigen::VectorXd curvature;
+  Eigen::VectorXd w;
   LbfgsMemory memory;
   std::vector<Pair> pairs;
+  std::shared_ptr<int> applications = std::make_shared<int>(0);  // of the preconditioner
   LbfgsMemory::Preconditioner preconditioner;
-  int applications = 0;
 };
 
-// The memory's product with g on 1, 2, 3 and 8 threads: `expected` to 1e-12, and bitwise the
-// same on each.
-void expect_product_on_every_thread_count(Fixture& f, const Eigen::VectorXd& g,
-                                          const Eigen::VectorXd& expected) {
+// make_fixture()'s first product with a random g on 1, 2, 3 and 8 threads, each on a fresh
+// fixture (so the pairs' P y are formed on that thread count too): `expected(fixture, g)` to
+// `tolerance` relative, and bitwise the same on each.
+template <class MakeFixture, class Expected>
+void expect_product_on_every_thread_count(MakeFixture&& make_fixture, Expected&& expected,
+                                          double tolerance) {
   const int threads_before = omp_get_max_threads();
   Eigen::VectorXd first;
   for (const int threads : {1, 2, 3, 8}) {
     omp_set_num_threads(threads);
+    Fixture f = make_fixture();
+    const Eigen::VectorXd g = random_vector(f.curvature.size(), f.random);
     const Eigen::VectorXd product = f.memory.times(g, f.preconditioner);
-    EXPECT_LE((product - expected).norm(), 1e-12 * expected.norm()) << g.size() << " " << threads;
+    const Eigen::VectorXd reference = expected(f, g);
+    EXPECT_LE((product - reference).norm(), tolerance * reference.norm())
+        << g.size() << " " << threads;
     if (threads == 1) {
       first = product;
     } else {
@@ -99,43 +119,41 @@ void expect_product_on_every_thread_count(Fixture& f, const Eigen::VectorXd& g,
   omp_set_num_threads(threads_before);
 }
 
-TEST(LbfgsMemory, TwoLoopAgreesWithTheSerialRecursionOnEveryThreadCount) {
+TEST(LbfgsMemory, ProductAgreesWithTheTwoLoopRecursionOnEveryThreadCount) {
   // Below one summation block, across the parallel threshold with a partial last block.
   for (const Eigen::Index n : {Eigen::Index{50}, kParallelMinimum + 4097}) {
-    Fixture f(n, 14, 10);  // 14 pairs added, the 10 newest kept
-    ASSERT_EQ(f.memory.size(), 10);
-    const Eigen::VectorXd g = random_vector(n, f.random);
-    const Eigen::VectorXd expected = serial_two_loop(f.pairs, g, f.p_diagonal);
-    expect_product_on_every_thread_count(f, g, expected);
+    expect_product_on_every_thread_count(
+        [n] { return Fixture(n, 14, 10); },  // 14 pairs added, the 10 newest kept
+        [](const Fixture& f, const Eigen::VectorXd& g) { return serial_two_loop(f.pairs, g, f.w); },
+        1e-12);
   }
 }
 
-// Pairs stored in single precision: the product is the recursion of the stored (rounded)
-// pairs, to double rounding, on every thread count bitwise the same; it stays within single
+// Pairs stored in single precision: on every thread count bitwise the same, within single
 // rounding of the double-precision product, and the pairs take half the bytes.
-TEST(LbfgsMemory, SinglePrecisionIsTheRecursionOfTheRoundedPairs) {
+TEST(LbfgsMemory, SinglePrecisionGivesTheProductToSingleRounding) {
   for (const Eigen::Index n : {Eigen::Index{50}, kParallelMinimum + 4097}) {
-    Fixture f(n, 14, 10, LbfgsPrecision::single_precision);
+    const Fixture single(n, 14, 10, LbfgsPrecision::single_precision);
     const Fixture exact(n, 14, 10);
-    ASSERT_EQ(f.memory.size(), 10);
-    EXPECT_EQ(f.memory.stored_entries(), 20 * n);
-    EXPECT_EQ(2 * f.memory.stored_bytes(), exact.memory.stored_bytes());
-    std::vector<Pair> rounded = f.pairs;
-    for (Pair& p : rounded) {
-      p.s = p.s.cast<float>().cast<double>();
-      p.y = p.y.cast<float>().cast<double>();
-    }
-    const Eigen::VectorXd g = random_vector(n, f.random);
-    const Eigen::VectorXd expected = serial_two_loop(rounded, g, f.p_diagonal);
-    const Eigen::VectorXd unrounded = serial_two_loop(f.pairs, g, f.p_diagonal);
-    // The rounding is visible, and small.
-    EXPECT_GT((expected - unrounded).norm(), 1e-12 * unrounded.norm());
-    EXPECT_LE((expected - unrounded).norm(), 1e-5 * unrounded.norm());
-    expect_product_on_every_thread_count(f, g, expected);
-    // A new precision clears the memory.
-    f.memory.set_precision(LbfgsPrecision::double_precision);
-    EXPECT_TRUE(f.memory.empty());
+    EXPECT_EQ(single.memory.stored_entries(), 20 * n);
+    EXPECT_EQ(2 * single.memory.stored_bytes(), exact.memory.stored_bytes());
+    expect_product_on_every_thread_count(
+        [n] { return Fixture(n, 14, 10, LbfgsPrecision::single_precision); },
+        [](const Fixture& f, const Eigen::VectorXd& g) { return serial_two_loop(f.pairs, g, f.w); },
+        1e-5);
+    // The rounding is visible.
+    Fixture rounded(n, 14, 10, LbfgsPrecision::single_precision);
+    Fixture unrounded(n, 14, 10);
+    ASSERT_EQ(rounded.memory.size(), 10);
+    const Eigen::VectorXd g = random_vector(n, rounded.random);
+    const Eigen::VectorXd difference = rounded.memory.times(g, rounded.preconditioner) -
+                                       unrounded.memory.times(g, unrounded.preconditioner);
+    EXPECT_GT(difference.norm(), 1e-12 * g.norm());
   }
+  // A new precision clears the memory.
+  Fixture f(50, 3, 10, LbfgsPrecision::single_precision);
+  f.memory.set_precision(LbfgsPrecision::double_precision);
+  EXPECT_TRUE(f.memory.empty());
 }
 
 TEST(LbfgsMemory, RefusesPairsWithoutPositiveCurvature) {
@@ -150,19 +168,89 @@ TEST(LbfgsMemory, RefusesPairsWithoutPositiveCurvature) {
   EXPECT_TRUE(f.memory.empty());
   // Without pairs the product is P g.
   const Eigen::VectorXd g = random_vector(100, f.random);
-  EXPECT_TRUE(f.memory.times(g, f.preconditioner) == f.p_diagonal.cwiseProduct(g));
+  EXPECT_TRUE(f.memory.times(g, f.preconditioner) == mixing(f.w, g));
 }
 
-TEST(LbfgsMemory, AppliesThePreconditionerToTheNewestPairOncePerPair) {
+// L-BFGS's order: a product at g_k, the pair to g_{k+1}, a product at g_{k+1}, ... on a
+// quadratic (y = A s). Each product applies P once (the newest pair's P y is P g_{k+1} -
+// P g_k) and agrees with the two-loop recursion; a product at another point after a pair was
+// added (an objective that changed between inner runs) applies P to that pair's y as well.
+TEST(LbfgsMemory, InLbfgsOrderEachProductAppliesThePreconditionerOnce) {
+  for (const Eigen::Index n : {Eigen::Index{50}, kParallelMinimum + 4097}) {
+    Fixture f(n, 0, 4);
+    Eigen::VectorXd g = random_vector(n, f.random);
+    Eigen::VectorXd d = -f.memory.times(g, f.preconditioner);
+    EXPECT_EQ(f.applied(), 1);
+    for (int k = 0; k < 7; ++k) {  // past the capacity: storage is reused
+      const double alpha = 0.3 + 0.1 * k;
+      const Eigen::VectorXd g_new = g + f.curvature.cwiseProduct(alpha * d);
+      f.memory.add(alpha, d, g_new, g, 4);
+      f.pairs.push_back({alpha * d, g_new - g});
+      if (f.pairs.size() > 4) f.pairs.erase(f.pairs.begin());
+      g = g_new;
+      const int before = f.applied();
+      const Eigen::VectorXd product = f.memory.times(g, f.preconditioner);
+      EXPECT_EQ(f.applied(), before + 1) << "pair " << k;
+      const Eigen::VectorXd expected = serial_two_loop(f.pairs, g, f.w);
+      EXPECT_LE((product - expected).norm(), 1e-12 * expected.norm()) << "pair " << k;
+      d = -product;
+    }
+    EXPECT_EQ(f.memory.size(), 4);
+    // The objective changes: the next product is taken elsewhere than the newest pair's end.
+    const double alpha = 0.5;
+    const Eigen::VectorXd g_new = g + f.curvature.cwiseProduct(alpha * d);
+    f.memory.add(alpha, d, g_new, g, 4);
+    f.pairs.push_back({alpha * d, g_new - g});
+    f.pairs.erase(f.pairs.begin());
+    const Eigen::VectorXd elsewhere = g_new + random_vector(n, f.random);
+    const int before = f.applied();
+    const Eigen::VectorXd product = f.memory.times(elsewhere, f.preconditioner);
+    EXPECT_EQ(f.applied(), before + 2);  // P y of the newest pair, then P g
+    const Eigen::VectorXd expected = serial_two_loop(f.pairs, elsewhere, f.w);
+    EXPECT_LE((product - expected).norm(), 1e-12 * expected.norm());
+  }
+}
+
+// A new inner run whose objective differs from the last one only on a few entries (as the
+// seed's correction load, nonzero only on the particles' nodes): after new_objective() the
+// newest pair's P y is formed by applying P, and the product is the recursion's on the pairs of
+// the old objective.
+TEST(LbfgsMemory, NewObjectiveFormsTheNewestPairsZByApplyingThePreconditioner) {
+  const Eigen::Index n = kParallelMinimum + 4097;
+  Fixture f(n, 0, 4);
+  Eigen::VectorXd g = random_vector(n, f.random);
+  Eigen::VectorXd d = -f.memory.times(g, f.preconditioner);
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::VectorXd g_new = g + f.curvature.cwiseProduct(d);
+    f.memory.add(1.0, d, g_new, g, 4);
+    f.pairs.push_back({d, g_new - g});
+    g = g_new;
+    d = -f.memory.times(g, f.preconditioner);
+  }
+  const Eigen::VectorXd g_new = g + f.curvature.cwiseProduct(d);
+  f.memory.add(1.0, d, g_new, g, 4);
+  f.pairs.push_back({d, g_new - g});
+  Eigen::VectorXd loaded = g_new;  // another objective's gradient at the same point
+  for (const Eigen::Index k : {Eigen::Index{5}, n / 2 + 3, n - 7}) loaded[k] += 1.0;
+  f.memory.new_objective();
+  const int before = f.applied();
+  const Eigen::VectorXd product = f.memory.times(loaded, f.preconditioner);
+  EXPECT_EQ(f.applied(), before + 2);  // P y of the newest pair, then P g
+  const Eigen::VectorXd expected = serial_two_loop(f.pairs, loaded, f.w);
+  EXPECT_LE((product - expected).norm(), 1e-12 * expected.norm());
+}
+
+TEST(LbfgsMemory, PairsAddedWithoutProductsAreCompletedByApplyingThePreconditioner) {
   Fixture f(200, 4, 10);
   const Eigen::VectorXd g = random_vector(200, f.random);
   (void)f.memory.times(g, f.preconditioner);
-  EXPECT_EQ(f.applications, 2);  // P y of the newest pair, then P q
+  EXPECT_EQ(f.applied(), 5);  // P y of each of the four pairs, then P g
   const Eigen::VectorXd again = f.memory.times(g, f.preconditioner);
-  EXPECT_EQ(f.applications, 3);  // P q only
-  f.memory.forget_scale();       // a new preconditioner: the scale is computed again
-  EXPECT_TRUE(f.memory.times(g, f.preconditioner) == again);
-  EXPECT_EQ(f.applications, 5);
+  EXPECT_EQ(f.applied(), 6);  // P g only
+  // Another preconditioner: the pairs, which hold P y, are dropped; the product is P g.
+  f.memory.preconditioner_changed();
+  EXPECT_TRUE(f.memory.empty());
+  EXPECT_TRUE(f.memory.times(g, f.preconditioner) == mixing(f.w, g));
 }
 
 }  // namespace

@@ -9,8 +9,8 @@
 // process's minimiser takes the same decisions.
 //
 // The positions and the gradient are not distributed (each process holds them whole); the
-// evaluation, most of a relaxation's work, is, and so are L-BFGS's stored pairs and its two-loop
-// recursion (vector_split(), solvers/lbfgs_memory.hpp). docs/mpi.md has what distributing the
+// evaluation, most of a relaxation's work, is, and so are L-BFGS's stored pairs and its product
+// (vector_split(), solvers/lbfgs_memory.hpp). docs/mpi.md has what distributing the
 // rest takes.
 
 #include <petscvec.h>  // with MPI's header, without its C++ bindings

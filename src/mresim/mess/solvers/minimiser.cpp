@@ -103,8 +103,9 @@ using detail::wolfe_line_search;
 
 // -------------------------------------------------------------------------------- L-BFGS
 
-// `precondition`: P of H0 = gamma P (null: the identity). `memory`: the pairs to start from
-// (empty: a fresh start); it holds the run's pairs on return.
+// `precondition`: P of H0 = gamma P (null: the identity), symmetric. `memory`: the pairs to
+// start from (empty: a fresh start), formed with this P (they hold P y); it holds the run's
+// pairs on return.
 InnerResult run_lbfgs(Objective& f, Eigen::VectorXd& u, int budget, const MinimiserOptions& opt,
                       const LbfgsMemory::Preconditioner* precondition, bool use_energy,
                       const std::function<bool(const Eigen::VectorXd&, double)>& converged,
@@ -123,7 +124,9 @@ InnerResult run_lbfgs(Objective& f, Eigen::VectorXd& u, int budget, const Minimi
     r.status = MinimiserStatus::converged;
     return r;
   }
-  memory.forget_scale();
+  // A new inner run's objective (the passes' load, the centre rule, M) may differ from the one
+  // the newest pair was taken on.
+  memory.new_objective();
   int failures = 0;
   constexpr int kStallIterations = 50;
   StallGuard guard(cur.g, kStallIterations);
@@ -468,6 +471,7 @@ class Minimisation {
       detail::NewtonSolver& newton = newton_solver();
       newton.update_centre_hessian();
       P = [&newton](const Eigen::VectorXd& v) { return newton.precondition(v); };
+      lbfgs_memory_.preconditioner_changed();  // its pairs hold P y of the previous P
     }
     return run_lbfgs(f_, u_, budget_, opt_, P ? &P : nullptr, use_energy_, test, lbfgs_memory_);
   }

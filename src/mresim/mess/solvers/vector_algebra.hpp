@@ -11,7 +11,8 @@
 // fused form does an update and the next dot product in one sweep, which saves one pass over
 // memory.
 //
-// L-BFGS (minimiser.cpp) uses them too: its two-loop recursion and the pair updates.
+// L-BFGS (minimiser.cpp) uses them for its line-search slopes and steps, and its memory
+// (lbfgs_memory.hpp) sums over the same fixed blocks.
 
 #include <Eigen/Core>
 #include <algorithm>
