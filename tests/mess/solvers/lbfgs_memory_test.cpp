@@ -85,6 +85,23 @@ struct Fixture {
   Fixture& operator=(Fixture&&) = delete;
   ~Fixture() = default;
   [[nodiscard]] int applied() const { return *applications; }
+  // The pair from g to g + A (alpha d), added as L-BFGS adds it; g moves to the new point.
+  void take_step(double alpha, const Eigen::VectorXd& d, Eigen::VectorXd& g, int capacity) {
+    const Eigen::VectorXd g_new = g + curvature.cwiseProduct(alpha * d);
+    memory.add(alpha, d, g_new, g, capacity);
+    pairs.push_back({alpha * d, g_new - g});
+    while (static_cast<int>(pairs.size()) > capacity) pairs.erase(pairs.begin());
+    g = g_new;
+  }
+  // The product at `at`: the recursion's to 1e-12, with `extra` applications of P.
+  Eigen::VectorXd checked_product(const Eigen::VectorXd& at, int extra) {
+    const int before = applied();
+    const Eigen::VectorXd product = memory.times(at, preconditioner);
+    EXPECT_EQ(applied(), before + extra);
+    const Eigen::VectorXd expected = serial_two_loop(pairs, at, w);
+    EXPECT_LE((product - expected).norm(), 1e-12 * expected.norm());
+    return product;
+  }
   std::mt19937_64 random;
   Eigen::VectorXd curvature;
   Eigen::VectorXd w;
@@ -182,32 +199,14 @@ TEST(LbfgsMemory, InLbfgsOrderEachProductAppliesThePreconditionerOnce) {
     Eigen::VectorXd d = -f.memory.times(g, f.preconditioner);
     EXPECT_EQ(f.applied(), 1);
     for (int k = 0; k < 7; ++k) {  // past the capacity: storage is reused
-      const double alpha = 0.3 + 0.1 * k;
-      const Eigen::VectorXd g_new = g + f.curvature.cwiseProduct(alpha * d);
-      f.memory.add(alpha, d, g_new, g, 4);
-      f.pairs.push_back({alpha * d, g_new - g});
-      if (f.pairs.size() > 4) f.pairs.erase(f.pairs.begin());
-      g = g_new;
-      const int before = f.applied();
-      const Eigen::VectorXd product = f.memory.times(g, f.preconditioner);
-      EXPECT_EQ(f.applied(), before + 1) << "pair " << k;
-      const Eigen::VectorXd expected = serial_two_loop(f.pairs, g, f.w);
-      EXPECT_LE((product - expected).norm(), 1e-12 * expected.norm()) << "pair " << k;
-      d = -product;
+      SCOPED_TRACE(k);
+      f.take_step(0.3 + 0.1 * k, d, g, 4);
+      d = -f.checked_product(g, 1);
     }
     EXPECT_EQ(f.memory.size(), 4);
     // The objective changes: the next product is taken elsewhere than the newest pair's end.
-    const double alpha = 0.5;
-    const Eigen::VectorXd g_new = g + f.curvature.cwiseProduct(alpha * d);
-    f.memory.add(alpha, d, g_new, g, 4);
-    f.pairs.push_back({alpha * d, g_new - g});
-    f.pairs.erase(f.pairs.begin());
-    const Eigen::VectorXd elsewhere = g_new + random_vector(n, f.random);
-    const int before = f.applied();
-    const Eigen::VectorXd product = f.memory.times(elsewhere, f.preconditioner);
-    EXPECT_EQ(f.applied(), before + 2);  // P y of the newest pair, then P g
-    const Eigen::VectorXd expected = serial_two_loop(f.pairs, elsewhere, f.w);
-    EXPECT_LE((product - expected).norm(), 1e-12 * expected.norm());
+    f.take_step(0.5, d, g, 4);
+    (void)f.checked_product(g + random_vector(n, f.random), 2);  // P y of the newest pair, P g
   }
 }
 
@@ -221,23 +220,14 @@ TEST(LbfgsMemory, NewObjectiveFormsTheNewestPairsZByApplyingThePreconditioner) {
   Eigen::VectorXd g = random_vector(n, f.random);
   Eigen::VectorXd d = -f.memory.times(g, f.preconditioner);
   for (int k = 0; k < 3; ++k) {
-    const Eigen::VectorXd g_new = g + f.curvature.cwiseProduct(d);
-    f.memory.add(1.0, d, g_new, g, 4);
-    f.pairs.push_back({d, g_new - g});
-    g = g_new;
+    f.take_step(1.0, d, g, 4);
     d = -f.memory.times(g, f.preconditioner);
   }
-  const Eigen::VectorXd g_new = g + f.curvature.cwiseProduct(d);
-  f.memory.add(1.0, d, g_new, g, 4);
-  f.pairs.push_back({d, g_new - g});
-  Eigen::VectorXd loaded = g_new;  // another objective's gradient at the same point
+  f.take_step(1.0, d, g, 4);
+  Eigen::VectorXd loaded = g;  // another objective's gradient at the same point
   for (const Eigen::Index k : {Eigen::Index{5}, n / 2 + 3, n - 7}) loaded[k] += 1.0;
   f.memory.new_objective();
-  const int before = f.applied();
-  const Eigen::VectorXd product = f.memory.times(loaded, f.preconditioner);
-  EXPECT_EQ(f.applied(), before + 2);  // P y of the newest pair, then P g
-  const Eigen::VectorXd expected = serial_two_loop(f.pairs, loaded, f.w);
-  EXPECT_LE((product - expected).norm(), 1e-12 * expected.norm());
+  (void)f.checked_product(loaded, 2);  // P y of the newest pair, then P g
 }
 
 TEST(LbfgsMemory, PairsAddedWithoutProductsAreCompletedByApplyingThePreconditioner) {
