@@ -41,8 +41,8 @@
 //
 // The pairs can be stored in single precision (set_precision): half the memory and half the
 // bytes the products sweep. Every dot product is formed from the stored (rounded) values, in
-// double, and q, P g and all sums stay in double; s and z are rounded independently (z from
-// P g_new - P g_old, not from the rounded y), so the operator is that of the rounded pairs to
+// double, and P g, the product and all sums stay in double; s and z are rounded independently (z
+// from P g_new - P g_old, not from the rounded y), so the operator is that of the rounded pairs to
 // single rounding (6e-8 relative) only.
 //
 // Over MPI processes (set_split, docs/mpi.md) each process stores only its own blocks of s and
