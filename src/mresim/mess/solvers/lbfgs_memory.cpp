@@ -313,9 +313,10 @@ Eigen::VectorXd LbfgsMemory::times_with(const std::deque<Stored>& S, std::deque<
   const Eigen::Index n = g.size();
   const int m = size();
   Eigen::VectorXd r = P(g);
+  const Fingerprint at = fingerprint(g);
   // The newest pair's z by difference if the products were taken in L-BFGS's order (header).
   const bool by_difference = m > 0 && !z_known_.back() && newest_by_difference_ && last_pg_known_ &&
-                             last_pg_.size() == n && fingerprint(g) == newest_g_new_;
+                             last_pg_.size() == n && at == newest_g_new_;
   for (int j = 0; j < m; ++j) {
     const bool pending = !z_known_[static_cast<std::size_t>(j)];
     if (pending && !(by_difference && j == m - 1)) complete_by_applying(S, Z, j, n, P);
@@ -324,7 +325,7 @@ Eigen::VectorXd LbfgsMemory::times_with(const std::deque<Stored>& S, std::deque<
   Eigen::VectorXd out = product_sum(S, Z, r, by_difference, coefficients(dots));
   if (split_ != nullptr) split_->share_entries(out);
   last_pg_ = std::move(r);
-  last_g_ = fingerprint(g);
+  last_g_ = at;
   last_pg_known_ = true;
   newest_by_difference_ = false;
   return out;
