@@ -129,6 +129,44 @@ TEST(ContactGap, KeepsPSymmetricPositiveDefiniteAndThreadIndependent) {
   omp_set_num_threads(threads);
 }
 
+// Three particles in a chain, 6 l_e apart: two pairs in contact, two gaps, built one per
+// thread where there are threads; each gap (its coordinates and its factor) is the same for
+// any number of threads.
+TEST(ContactGap, SeveralGapsAreTheSameOnEveryThreadCount) {
+  mess::MessSystem sys =
+      mess::MessSystem::make(small_lattice(mess::model_profile("physical"), {12, 12, 26},
+                                           {{6, 6, 7}, {6, 6, 13}, {6, 6, 19}}, 2),
+                             tesla(0.0, 0.0, 0.0), mess::model_profile("physical"));
+  sys.set_constraints(
+      faces_held(sys.lattice(), {lat::Face::left, lat::Face::right, lat::Face::front,
+                                 lat::Face::back, lat::Face::bottom, lat::Face::top}));
+  const mess::DofMap map(sys.constraints(), sys.lattice().positions, sys.lattice().element_length);
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const mess::ContactGapBlocks one(sys, map, kGapForceScale, sys.positions());
+  omp_set_num_threads(2);
+  const mess::ContactGapBlocks two(sys, map, kGapForceScale, sys.positions());
+  omp_set_num_threads(threads);
+  ASSERT_EQ(one.gaps(), 2U);
+  ASSERT_EQ(two.gaps(), 2U);
+  EXPECT_EQ(one.dofs(), two.dofs());
+  for (std::size_t g = 0; g < 2; ++g) {
+    const Eigen::SparseMatrix<float>& a = one.factor(g).matrixL().nestedExpression();
+    const Eigen::SparseMatrix<float>& b = two.factor(g).matrixL().nestedExpression();
+    ASSERT_EQ(a.nonZeros(), b.nonZeros()) << g;
+    EXPECT_EQ(Eigen::Map<const Eigen::VectorXf>(a.valuePtr(), a.nonZeros()),
+              Eigen::Map<const Eigen::VectorXf>(b.valuePtr(), b.nonZeros()))
+        << g;
+  }
+  const Eigen::VectorXd v = uniform_random_vector(map.size(), 14);
+  Eigen::VectorXd w_one = Eigen::VectorXd::Zero(map.size());
+  Eigen::VectorXd w_two = Eigen::VectorXd::Zero(map.size());
+  one.add_to(v, w_one);
+  two.add_to(v, w_two);
+  EXPECT_EQ(w_one, w_two);
+  EXPECT_GT(w_one.norm(), 0.0);
+}
+
 // L-BFGS with the multilevel preconditioner: a pair 6 l_e apart drawn together at 100 mT
 // (physical profile), to 1e-9 k_eff l_e, reaches the same state with and without the gap.
 TEST(ContactGap, MinimiserReachesTheSameStateWithOrWithoutTheGap) {

@@ -9,6 +9,8 @@
 #include <Eigen/SparseCore>
 #include <cstring>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "../support/mess_test_support.hpp"
 #include "mresim/mess/terms/elastic_terms.hpp"
@@ -140,6 +142,74 @@ TEST(MessElasticHessian, ProductsIndependentOfThreadCount) {
   const Eigen::Matrix3Xd three = product();
   omp_set_num_threads(saved);
   EXPECT_EQ(std::memcmp(one.data(), three.data(), sizeof(double) * one.size()), 0);
+}
+
+namespace {
+
+// Records every block it is given, in order; with `nodes` set it says it keeps only the blocks
+// between those nodes (HessianBlockSink::takes_node) and drops the others.
+class RecordingSink final : public mess::HessianBlockSink {
+ public:
+  struct Block {
+    std::int64_t i;
+    std::int64_t j;
+    Eigen::Matrix3d b;
+  };
+  explicit RecordingSink(std::vector<char> nodes = {}) : nodes_(std::move(nodes)) {}
+  void add(std::int64_t i, std::int64_t j, const Eigen::Matrix3d& block) override {
+    if (filters_nodes() && !(takes_node(i) && takes_node(j))) return;
+    blocks.push_back({i, j, block});
+  }
+  [[nodiscard]] bool filters_nodes() const override { return !nodes_.empty(); }
+  [[nodiscard]] bool takes_node(std::int64_t n) const override {
+    return nodes_.empty() || nodes_[static_cast<std::size_t>(n)] != 0;
+  }
+  std::vector<Block> blocks;
+
+ private:
+  std::vector<char> nodes_;
+};
+
+}  // namespace
+
+// A sink that keeps only some nodes' blocks lets the kernels skip the springs and cells without
+// such a node (the contact gaps' blocks): it must still get exactly the blocks between its nodes
+// that the whole sweep delivers, bit for bit and in the same order, so that its sums do not
+// change.
+TEST(MessElasticHessian, FilteringSinkGetsTheWholeSweepsBlocksBetweenItsNodes) {
+  const lat::Lattice l = small_lattice(mess::model_profile("seed"), {6, 6, 7}, {{3, 3, 3}});
+  std::vector<char> nodes(static_cast<std::size_t>(l.node_count()), 0);
+  // A corner region of 2 x 3 x 2 nodes and a lone node: terms with one, some or all nodes in it.
+  for (int ix = 0; ix < 2; ++ix) {
+    for (int iy = 1; iy < 4; ++iy) {
+      for (int iz = 2; iz < 4; ++iz)
+        nodes[static_cast<std::size_t>(l.shape.node_index(ix, iy, iz))] = 1;
+    }
+  }
+  nodes[static_cast<std::size_t>(l.shape.node_index(4, 4, 5))] = 1;
+  for (const Eigen::Matrix3Xd& x : states(l)) {
+    RecordingSink whole;
+    RecordingSink filtered(nodes);
+    mess::SpringKernel::add_hessian_blocks(l, x, whole);
+    mess::VolumeKernel::add_hessian_blocks(l, x, 4.0, whole);
+    mess::SpringKernel::add_hessian_blocks(l, x, filtered);
+    mess::VolumeKernel::add_hessian_blocks(l, x, 4.0, filtered);
+    std::vector<RecordingSink::Block> expected;
+    for (const RecordingSink::Block& b : whole.blocks) {
+      if (nodes[static_cast<std::size_t>(b.i)] != 0 && nodes[static_cast<std::size_t>(b.j)] != 0) {
+        expected.push_back(b);
+      }
+    }
+    ASSERT_GT(expected.size(), 100U);
+    ASSERT_EQ(filtered.blocks.size(), expected.size());
+    for (std::size_t k = 0; k < expected.size(); ++k) {
+      EXPECT_EQ(filtered.blocks[k].i, expected[k].i) << k;
+      EXPECT_EQ(filtered.blocks[k].j, expected[k].j) << k;
+      EXPECT_EQ(std::memcmp(filtered.blocks[k].b.data(), expected[k].b.data(), 9 * sizeof(double)),
+                0)
+          << k;
+    }
+  }
 }
 
 TEST(MessWcaHessian, PairProductMatchesDifferencesOfTheGradient) {

@@ -25,6 +25,11 @@ class GapSink final : public HessianBlockSink {
     if (li < 0 || local_[static_cast<std::size_t>(j)] < 0) return;
     blocks_[27 * static_cast<std::size_t>(li) + neighbour_code(i, j)] += scale_ * block;
   }
+  // Only the gap's nodes: the kernels skip the rest of the lattice.
+  [[nodiscard]] bool filters_nodes() const override { return true; }
+  [[nodiscard]] bool takes_node(std::int64_t n) const override {
+    return local_[static_cast<std::size_t>(n)] >= 0;
+  }
   // The lower triangle of the gap's block of the Hessian, in single precision (all the factor
   // reads): row and column 3 k + a for the k-th gap node.
   [[nodiscard]] Eigen::SparseMatrix<float> lower_matrix(
@@ -112,32 +117,52 @@ ContactGapBlocks::ContactGapBlocks(const MessSystem& system, const DofMap& map, 
                                    const Eigen::Matrix3Xd& at) {
   const lattice::Lattice& lat = system.lattice();
   const Eigen::Matrix3Xd centres = system.particle_centres_at(at, CentreRule::all_nodes);
-  const double scale = lat.element_length / force_scale;
-  std::vector<std::int32_t> local;  // node -> its index in the current gap, or -1
-  for (const auto& [p, q] : contact_pairs(centres, lat.particle_radius)) {
-    const std::vector<std::int64_t> nodes =
-        gap_nodes(system, map, at, centres.col(p), centres.col(q));
-    if (nodes.empty()) continue;
-    local.assign(static_cast<std::size_t>(lat.node_count()), -1);
-    Gap gap;
-    for (std::size_t k = 0; k < nodes.size(); ++k) {
-      local[static_cast<std::size_t>(nodes[k])] = static_cast<std::int32_t>(k);
-      for (int a = 0; a < 3; ++a) gap.dofs.push_back(map.own_dof_of_coordinate(3 * nodes[k] + a));
-    }
-    Eigen::SparseMatrix<float> lower;
-    {
-      GapSink sink(lat.shape, local, nodes.size(), scale);
-      system.add_elastic_hessian_blocks(sink, at);
-      lower = sink.lower_matrix(nodes);
-    }
-    gap.factor = std::make_unique<Eigen::SimplicialLLT<Eigen::SparseMatrix<float>>>(lower);
-    if (gap.factor->info() != Eigen::Success) {
+  const std::vector<std::pair<int, int>> pairs = contact_pairs(centres, lat.particle_radius);
+  // The gaps are independent: with several pairs in contact (the helix's clusters) each thread
+  // builds whole gaps, in the pairs' order; each gap is the same for any number of threads.
+  std::vector<Gap> built(pairs.size());
+  std::vector<char> factored(pairs.size(), 0);
+  const auto count = static_cast<std::int64_t>(pairs.size());
+#pragma omp parallel for schedule(dynamic) if (count > 1)
+  for (std::int64_t k = 0; k < count; ++k) {
+    const auto [p, q] = pairs[static_cast<std::size_t>(k)];
+    factored[static_cast<std::size_t>(k)] =
+        build_gap(system, map, force_scale, at, centres.col(p), centres.col(q),
+                  built[static_cast<std::size_t>(k)])
+            ? 1
+            : 0;
+  }
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    if (built[k].dofs.empty()) continue;  // no polymer node between them
+    if (factored[k] == 0) {
       ++left_out_;  // not positive definite (header)
       continue;
     }
-    gap.solves = detail::SplitCholeskySolve(gap.factor->matrixL().nestedExpression());
-    gaps_.push_back(std::move(gap));
+    gaps_.push_back(std::move(built[k]));
   }
+}
+
+bool ContactGapBlocks::build_gap(const MessSystem& system, const DofMap& map, double force_scale,
+                                 const Eigen::Matrix3Xd& at, const Eigen::Vector3d& first,
+                                 const Eigen::Vector3d& second, Gap& gap) {
+  const lattice::Lattice& lat = system.lattice();
+  const std::vector<std::int64_t> nodes = gap_nodes(system, map, at, first, second);
+  if (nodes.empty()) return false;
+  std::vector<std::int32_t> local(static_cast<std::size_t>(lat.node_count()), -1);
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    local[static_cast<std::size_t>(nodes[k])] = static_cast<std::int32_t>(k);
+    for (int a = 0; a < 3; ++a) gap.dofs.push_back(map.own_dof_of_coordinate(3 * nodes[k] + a));
+  }
+  Eigen::SparseMatrix<float> lower;
+  {
+    GapSink sink(lat.shape, local, nodes.size(), lat.element_length / force_scale);
+    system.add_elastic_hessian_blocks(sink, at);
+    lower = sink.lower_matrix(nodes);
+  }
+  gap.factor = std::make_unique<Eigen::SimplicialLLT<Eigen::SparseMatrix<float>>>(lower);
+  if (gap.factor->info() != Eigen::Success) return false;
+  gap.solves = detail::SplitCholeskySolve(gap.factor->matrixL().nestedExpression());
+  return true;
 }
 
 void ContactGapBlocks::add_to(const Eigen::VectorXd& v, Eigen::VectorXd& w) const {

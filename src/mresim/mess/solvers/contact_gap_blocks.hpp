@@ -30,7 +30,10 @@
 // symmetric positive definite.
 //
 // Cost. The block is assembled from one sweep of the system's elastic Hessian blocks per gap
-// (serial; only where a pair is in contact; 27 blocks per gap node while it is summed), and
+// (only where a pair is in contact; 27 blocks per gap node while it is summed), in which the
+// springs and cells without a gap node are skipped (HessianBlockSink::takes_node: the full-size
+// helix spent about 6 s per step computing the whole lattice's blocks for its gaps before, now
+// a few hundredths), one gap per thread where there are several, and
 // factored with a sparse Cholesky factor (Eigen's SimplicialLLT, AMD ordering) in single
 // precision: on the full-size Fig. 4.11 lattice in contact 6,951 coordinates and 2.46 million
 // entries of L, 20 MB (69 bytes per lattice node; 30 MB in double). Applying it is a forward
@@ -99,6 +102,11 @@ class ContactGapBlocks {
                                              const Eigen::Matrix3Xd& x,
                                              const Eigen::Vector3d& first,
                                              const Eigen::Vector3d& second);
+  // Gap `gap` between the particles centred at `first` and `second`: its dofs, and its factor
+  // if its block is positive definite (then true).
+  static bool build_gap(const MessSystem& system, const DofMap& map, double force_scale,
+                        const Eigen::Matrix3Xd& at, const Eigen::Vector3d& first,
+                        const Eigen::Vector3d& second, Gap& gap);
   std::vector<Gap> gaps_;
   int left_out_ = 0;
 };

@@ -482,10 +482,12 @@ void SpringKernel::add_hessian_product(const lattice::Lattice& lat, const Eigen:
 void SpringKernel::add_hessian_blocks(const lattice::Lattice& lat, const Eigen::Matrix3Xd& x,
                                       HessianBlockSink& sink) {
   const lattice::SpringSet& sp = lat.springs;
+  const bool filtered = sink.filters_nodes();
   for (std::size_t s = 0; s < sp.size(); ++s) {
-    const Eigen::Matrix3d block = spring_block(sp, s, x);
     const std::int64_t i = sp.first[s];
     const std::int64_t j = sp.second(s);
+    if (filtered && !sink.takes_node(i) && !sink.takes_node(j)) continue;  // no block kept
+    const Eigen::Matrix3d block = spring_block(sp, s, x);
     sink.add(i, i, block);
     sink.add(j, j, block);
     sink.add(i, j, -block);
@@ -780,7 +782,12 @@ void VolumeKernel::add_hessian_blocks(const lattice::Lattice& lat, const Eigen::
     unit_edges[column] = lattice::averaged_edge_vectors(unit);
   }
   Eigen::Matrix<double, 24, 24> cell;
+  const bool filtered = sink.filters_nodes();
   for (const auto& element : lat.elements) {
+    if (filtered && std::none_of(element.begin(), element.end(),
+                                 [&](std::int64_t n) { return sink.takes_node(n); })) {
+      continue;  // no block of this cell is kept
+    }
     const lattice::EdgeVectors e = lattice::averaged_edge_vectors(gather_vertices(element, x));
     // Column (l, b) of the cell's block: its product with the unit vector of that coordinate.
     for (Eigen::Index column = 0; column < 24; ++column) {

@@ -24,6 +24,16 @@ class HessianBlockSink {
 
   // Adds `block` at rows 3 i .. 3 i + 2, columns 3 j .. 3 j + 2.
   virtual void add(std::int64_t i, std::int64_t j, const Eigen::Matrix3d& block) = 0;
+
+  // A sink that keeps only the blocks between some nodes says so here: then add(i, j, B) has
+  // no effect unless takes_node(i) and takes_node(j), and a term may skip computing its blocks
+  // when it has no node the sink takes (every term delivers a block (n, n) for each of its
+  // nodes n, so such a term changes nothing). The blocks that arrive, and their order, stay
+  // those of the whole sweep, so the sums are bitwise the same. Why: the contact gaps'
+  // blocks (solvers/contact_gap_blocks.hpp) need a few thousand of a lattice's nodes, and the
+  // whole sweep over a full-size lattice took seconds per gap.
+  [[nodiscard]] virtual bool filters_nodes() const { return false; }
+  [[nodiscard]] virtual bool takes_node(std::int64_t /*n*/) const { return true; }
 };
 
 // Appends 9 triplets per block (duplicates are summed by Eigen's setFromTriplets).
