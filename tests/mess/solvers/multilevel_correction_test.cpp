@@ -298,6 +298,29 @@ TEST(MultilevelCorrection, IsLeftOutWhereNothingIsHeld) {
   EXPECT_EQ(p.apply(map, v), plain.apply(map, v));
 }
 
+// The levels the default chooses for the full-size lattices: the Fig. 4.25 helix (66 x 66 x 228
+// nodes) has its third level, 10 x 10 x 30 points (9,000 coordinates), solved exactly (with
+// the earlier limit of 4,000 coordinates it took a fourth, 6 x 6 x 16); Fig. 4.11's lattice
+// (44 x 44 x 147) is bound by the rule that the exact level holds at most 1/64 of the
+// lattice's coordinates, so its 7 x 7 x 20 level stays the coarsest whatever the limit.
+TEST(MultilevelCorrection, DefaultLevelsOfTheFullSizeLattices) {
+  using Points = std::vector<std::array<int, 3>>;
+  const Points helix = {{34, 34, 115}, {18, 18, 58}, {10, 10, 30}};
+  EXPECT_EQ(mess::MultilevelCorrection::level_points(
+                {66, 66, 228}, mess::MultilevelCorrection::kDefaultExactLimit),
+            helix);
+  const Points helix_before = {{34, 34, 115}, {18, 18, 58}, {10, 10, 30}, {6, 6, 16}};
+  EXPECT_EQ(mess::MultilevelCorrection::level_points({66, 66, 228}, 4000), helix_before);
+  const Points pair = {{23, 23, 74}, {12, 12, 38}, {7, 7, 20}};
+  for (const Eigen::Index limit :
+       {Eigen::Index{4000}, mess::MultilevelCorrection::kDefaultExactLimit,
+        Eigen::Index{1} << 40}) {
+    EXPECT_EQ(mess::MultilevelCorrection::level_points({44, 44, 147}, limit), pair) << limit;
+  }
+  EXPECT_THROW((void)mess::MultilevelCorrection::level_points({44, 44, 147}, 0),
+               std::invalid_argument);
+}
+
 // A run keeps one plain preconditioner (built at rest) while the free coordinates stay, and
 // builds a new one when they change (another face held) or the multilevel choice does; one with
 // the multilevel correction is built anew at every request, at the system's positions.

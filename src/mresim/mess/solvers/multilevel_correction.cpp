@@ -131,13 +131,9 @@ MultilevelCorrection::MultilevelCorrection(const lattice::Lattice& lattice,
                                            double force_scale, const Eigen::Matrix3Xd* state,
                                            Eigen::Index exact_limit,
                                            const detail::BlockSplit* processes) {
-  if (exact_limit < 1) {
-    throw std::invalid_argument("MultilevelCorrection: exact_limit " + std::to_string(exact_limit) +
-                                " must be at least 1");
-  }
   fine_ = lattice.shape.nodes;
   own_dofs_ = map.own_dofs();
-  build_levels(exact_limit);
+  levels_ = build_levels(fine_, exact_limit);
   assemble(lattice, volume_force_factor, lattice.element_length / force_scale, map, state,
            processes);
 }
@@ -167,11 +163,24 @@ void MultilevelCorrection::add_restriction_terms(Axis& axis, int points) {
   }
 }
 
-void MultilevelCorrection::build_levels(Eigen::Index exact_limit) {
+std::vector<std::array<int, 3>> MultilevelCorrection::level_points(const std::array<int, 3>& nodes,
+                                                                   Eigen::Index exact_limit) {
+  std::vector<std::array<int, 3>> points;
+  for (const Level& level : build_levels(nodes, exact_limit)) points.push_back(level.points);
+  return points;
+}
+
+std::vector<MultilevelCorrection::Level> MultilevelCorrection::build_levels(
+    const std::array<int, 3>& fine, Eigen::Index exact_limit) {
+  if (exact_limit < 1) {
+    throw std::invalid_argument("MultilevelCorrection: exact_limit " + std::to_string(exact_limit) +
+                                " must be at least 1");
+  }
+  std::vector<Level> levels;
   std::array<std::vector<int>, 3> planes;
   for (std::size_t a = 0; a < 3; ++a) {
-    planes[a].resize(static_cast<std::size_t>(fine_[a]));
-    for (int i = 0; i < fine_[a]; ++i) planes[a][static_cast<std::size_t>(i)] = i;
+    planes[a].resize(static_cast<std::size_t>(fine[a]));
+    for (int i = 0; i < fine[a]; ++i) planes[a][static_cast<std::size_t>(i)] = i;
   }
   while (true) {
     Level level;
@@ -194,14 +203,15 @@ void MultilevelCorrection::build_levels(Eigen::Index exact_limit) {
       level.points[a] = m;
     }
     // A grid of two planes per axis cannot be coarsened: the previous level is the coarsest.
-    if (!coarser && !levels_.empty()) break;
+    if (!coarser && !levels.empty()) break;
     for (std::size_t a = 0; a < 3; ++a) planes[a] = level.axes[a].plane;
-    levels_.push_back(std::move(level));
+    levels.push_back(std::move(level));
     // The coarsest level is solved exactly at every application, so it must also be small
     // against the lattice: at most 1/64 of its coordinates (two coarsenings where possible).
-    const std::int64_t size = 3 * point_count(levels_.back().points);
-    if (size <= exact_limit && 64 * size <= 3 * point_count(fine_)) break;
+    const std::int64_t size = 3 * point_count(levels.back().points);
+    if (size <= exact_limit && 64 * size <= 3 * point_count(fine)) break;
   }
+  return levels;
 }
 
 namespace {

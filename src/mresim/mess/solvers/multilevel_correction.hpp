@@ -62,7 +62,12 @@ namespace mresim::mess {
 
 class MultilevelCorrection {
  public:
-  static constexpr Eigen::Index kDefaultExactLimit = 4000;
+  // The largest coarsest level solved exactly (coordinates). 10,000 takes the Fig. 4.25
+  // helix's (66 x 66 x 228 nodes) third level, 10 x 10 x 30 points, instead of its fourth: its
+  // strained steps need 1.33x fewer iterations and run 1.26x faster, for 60 MB more peak
+  // memory (docs/performance.md, "A finer exact level for the helix"). The other
+  // chapter 4 lattices are bound by the 1/64 rule of build_levels and keep their levels.
+  static constexpr Eigen::Index kDefaultExactLimit = 10000;
 
   // Scaled like the minimiser's variables (RigidParticlePreconditioner): A l_e / force_scale.
   // `volume_force_factor`: the volume term's force factor (MessSettings::elastic).
@@ -83,6 +88,10 @@ class MultilevelCorrection {
   void add_to(const DofMap& map, const Eigen::VectorXd& v, Eigen::VectorXd& w) const;
 
   int levels() const { return static_cast<int>(levels_.size()); }
+  // The grid points (along x, y, z) of each level a lattice of `nodes` points gets, finest
+  // first, the last solved exactly: what the constructor builds, without building it.
+  static std::vector<std::array<int, 3>> level_points(const std::array<int, 3>& nodes,
+                                                      Eigen::Index exact_limit);
   // Coarse coordinates of level l (1-based, as in the header): 3 x its grid points.
   Eigen::Index level_size(int level) const;
 
@@ -107,7 +116,7 @@ class MultilevelCorrection {
     Eigen::VectorXd inverse_diagonal;
   };
 
-  void build_levels(Eigen::Index exact_limit);
+  static std::vector<Level> build_levels(const std::array<int, 3>& fine, Eigen::Index exact_limit);
   static void add_restriction_terms(Axis& axis, int points);
   void assemble(const lattice::Lattice& lattice, double volume_force_factor, double scale,
                 const DofMap& map, const Eigen::Matrix3Xd* state,
