@@ -220,8 +220,11 @@ int execute_and_publish(const config::TableReader& root, const app::RunPlan& pla
     app::Progress progress(0, run_type);
     try {
       plan.execute(run_dir.path(), results, progress);
-      // Run types without checkpoints finish their computation, then stop here.
-      app::throw_if_stop_requested("before the results were published");
+      // Run types without checkpoints finish their computation, then stop here. Those that stop
+      // at their own safe points have finished it: a late signal does not discard it (below).
+      if (!plan.stops_at_own_safe_points()) {
+        app::throw_if_stop_requested("before the results were published");
+      }
     } catch (const app::InvalidResults& e) {
       invalid_results = e.what();
     } catch (const app::Interrupted& e) {
@@ -245,7 +248,17 @@ int execute_and_publish(const config::TableReader& root, const app::RunPlan& pla
     }
     std::fflush(stdout);
   }
-  const int plot_status = no_plot ? kSuccess : draw_figures(run_dir.final_path(), {}, quiet);
+  // A stop signal after the plan's last safe point: the results above are complete (publishing
+  // them was quicker and safer than discarding hours of work); the figures are left out.
+  const int late_signal = app::stop_signal();
+  if (late_signal != 0) {
+    app::run_output().record(fmt::format(
+        "mresim: {} came after the last step; the results are complete in '{}', the figures were "
+        "not drawn (draw them with 'mresim plot {}')",
+        app::signal_name(late_signal), out.string(), out.string()));
+  }
+  const int plot_status =
+      no_plot || late_signal != 0 ? kSuccess : draw_figures(run_dir.final_path(), {}, quiet);
   if (plot_status != kSuccess) {
     app::run_output().error(
         fmt::format("mresim: error: drawing the figures failed; the results are complete in '{}' "

@@ -93,6 +93,32 @@ TEST(RunSafety, AStopSignalEndsARunWithoutCheckpointsLeavingNothing) {
   }
 }
 
+// A stop signal after the last step (here raised by the plan itself while it writes its
+// results): a plan that stops at safe points of its own (the 3D run types) has finished its
+// computation, so the results are published, the command says so and exits with 0; a plan
+// without such points publishes nothing, as above.
+TEST(RunSafety, AStopSignalAfterTheLastStepKeepsTheResultsOfPlansWithOwnSafePoints) {
+  for (const bool own : {true, false}) {
+    const TempDir dir;
+    write_text(dir / "late.toml", std::string("[run]\ntype = \"test_dummy\"\n[dummy]\nsteps = 5\n"
+                                              "signal_after_last_step = true\nown_safe_points = ") +
+                                      (own ? "true" : "false") + "\n");
+    const pid_t pid = start(dir.path(), {"run", "late.toml", "--out", "out", "--no-plot"}, "run");
+    const std::string err_file = (dir / "run.err").string();
+    if (own) {
+      EXPECT_EQ(wait_for(pid), 0) << read_text(err_file);
+      EXPECT_EQ(Hdf5Reader(dir / "out" / "results.h5").doubles("/dummy/values").size(), 5U);
+      EXPECT_NE(read_text(err_file).find("mresim: SIGINT came after the last step; the results "
+                                         "are complete in 'out', the figures were not drawn"),
+                std::string::npos)
+          << read_text(err_file);
+    } else {
+      EXPECT_EQ(wait_for(pid), 128 + SIGINT);
+      EXPECT_FALSE(fs::exists(dir / "out"));
+    }
+  }
+}
+
 // Non-finite results are published with the bad entries marked, and the run fails (status 4).
 TEST(RunSafety, NonFiniteResultsAreKeptMarkedAndTheRunExitsWith4) {
   const TempDir dir;

@@ -10,10 +10,14 @@
 //   fail_at = 2       # optional: throw at this step, to test cleanup
 //   nan_at = 1        # optional: this step's value is NaN (invalid results, exit status 4)
 //   step_seconds = 0.2  # optional: sleep this long per step (locks, signals)
+//   own_safe_points = true        # optional: the plan says it stops at safe points of its own
+//                                 # (RunPlan::stops_at_own_safe_points), as the 3D run types do
+//   signal_after_last_step = true # optional: raise SIGINT in this process after the last step
 
 #include <omp.h>
 
 #include <chrono>
+#include <csignal>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -37,7 +41,11 @@ class DummyPlan final : public mresim::app::RunPlan {
     fail_at_ = dummy.integer_or("fail_at", -1, Range::any());
     nan_at_ = dummy.integer_or("nan_at", -1, Range::any());
     step_seconds_ = dummy.number_or("step_seconds", 0.0, Range::between(0.0, 60.0), "s");
+    own_safe_points_ = dummy.boolean_or("own_safe_points", false);
+    signal_after_last_step_ = dummy.boolean_or("signal_after_last_step", false);
   }
+
+  [[nodiscard]] bool stops_at_own_safe_points() const override { return own_safe_points_; }
 
   void describe(mresim::app::InfoReport& report) const override {
     report.add_integer("dummy", "steps", steps_);
@@ -60,6 +68,7 @@ class DummyPlan final : public mresim::app::RunPlan {
       csv.row({static_cast<double>(i), values.back()});
       progress.advance();
     }
+    if (signal_after_last_step_) (void)std::raise(SIGINT);  // as a Ctrl-C during the writes
     csv.close();
     results.write_vector("/dummy/values", values, "m");
     results.write_int_attribute("/dummy", "threads", omp_get_max_threads());
@@ -72,6 +81,8 @@ class DummyPlan final : public mresim::app::RunPlan {
   long fail_at_ = -1;
   long nan_at_ = -1;
   double step_seconds_ = 0.0;
+  bool own_safe_points_ = false;
+  bool signal_after_last_step_ = false;
 };
 
 const mresim::app::RunTypeRegistrar dummy_run_type_registrar(

@@ -37,6 +37,13 @@ class RunPlan {
   // rank 0's staging directory when it resumes from a checkpoint there, else empty. Plans that
   // cannot keep these defaults; the commands then refuse to run under mpirun.
   [[nodiscard]] virtual bool splits_over_processes() const { return false; }
+  // Plans that stop at safe points of their own (the 3D run types: at a step boundary, with a
+  // checkpoint, ending with Interrupted{resumable = true}) return true. When their execute()
+  // returns, the computation is complete: a stop signal that came after its last safe point
+  // (during the last step, or while the results were written) does not discard it; the results
+  // are published and the command says so. Default false: a stop signal ends the run after
+  // execute(), publishing nothing (stop_signal.hpp).
+  [[nodiscard]] virtual bool stops_at_own_safe_points() const { return false; }
   // Default: throws std::logic_error.
   virtual void participate(const std::filesystem::path& staging_dir) const;
 };

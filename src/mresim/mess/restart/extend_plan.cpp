@@ -55,6 +55,9 @@ class ExtendPlan final : public app::RunPlan {
   [[nodiscard]] bool splits_over_processes() const override {
     return inner_->splits_over_processes();
   }
+  [[nodiscard]] bool stops_at_own_safe_points() const override {
+    return inner_->stops_at_own_safe_points();
+  }
 
   // The other processes: the extended run from the staging directory that execute() prepared.
   void participate(const fs::path& /*staging_dir*/) const override {

@@ -55,6 +55,9 @@ class MessPlan final : public app::RunPlan {
   }
 
   [[nodiscard]] bool splits_over_processes() const override { return true; }
+  // A stop request is answered at the next step boundary (execute's loop); after the last
+  // step the results are complete and are published.
+  [[nodiscard]] bool stops_at_own_safe_points() const override { return true; }
 
   void describe(app::InfoReport& report) const override { mc::describe_mess(spec_, report); }
 
