@@ -69,8 +69,8 @@ TEST(RunTypes, ReportsProblemsInTheRunTable) {
 
 TEST(RunTypes, RejectsUnknownKeysAfterTheRunTypeHasReadItsTables) {
   EXPECT_EQ(config_error_of("[run]\ntype = \"test_dummy\"\n[dummy]\nsteps = 1\nscael = 2\n"),
-            "unknown key 'dummy.scael' in [dummy]; allowed keys: fail_at, nan_at, scale, "
-            "step_seconds, steps");
+            "unknown key 'dummy.scael' in [dummy]; allowed keys: fail_at, nan_at, "
+            "own_safe_points, scale, signal_after_last_step, step_seconds, steps");
   EXPECT_EQ(config_error_of("[run]\ntype = \"test_dummy\"\ntitel = \"x\"\n[dummy]\nsteps = 1\n"),
             "unknown key 'run.titel' in [run]; allowed keys: threads, title, type");
   EXPECT_EQ(config_error_of("[run]\ntype = \"test_dummy\"\n[dummy]\nsteps = 1\n[extra]\n"),

@@ -187,7 +187,7 @@ TEST(Cli, UnknownKeysAreRejectedBeforeAnythingIsWritten) {
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.err,
             "mresim: error: unknown key 'dummy.scael' in [dummy]; allowed keys: fail_at, nan_at, "
-            "scale, step_seconds, steps\n");
+            "own_safe_points, scale, signal_after_last_step, step_seconds, steps\n");
   EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"typo.toml"});
 }
 
