@@ -124,7 +124,8 @@ class Run:
         The computation releases the GIL; runs started from several Python threads take
         turns. Ctrl-C (or a notebook's interrupt) stops it at its
         next safe point, as on the command line, and raises KeyboardInterrupt; a 3D run then
-        keeps its checkpoint in ``out`` for ``mresim resume``.
+        keeps its checkpoint in ``out`` for ``mresim resume`` (or, stopped during its last
+        step, its complete results, without figures; the message says which).
         """
         thread_count = _thread_count(threads)
         temporary = None
@@ -134,13 +135,20 @@ class Run:
         out = os.fspath(out)
         try:
             with _one_run_at_a_time:
-                status = self._plan.execute(out, thread_count, bool(force), bool(plot))
+                status, published = self._plan.execute(out, thread_count, bool(force), bool(plot))
             if status >= 128:
-                where = (
-                    "nothing was kept (temporary directory)"
-                    if temporary
-                    else f"continue a 3D run with 'mresim resume {out}'"
-                )
+                if published:  # the signal came during a 3D run's last step
+                    where = (
+                        "the results were complete (temporary directory, removed)"
+                        if temporary
+                        else f"it came after the last step: the results are complete in '{out}'"
+                    )
+                else:
+                    where = (
+                        "nothing was kept (temporary directory)"
+                        if temporary
+                        else f"continue a 3D run with 'mresim resume {out}'"
+                    )
                 raise KeyboardInterrupt(f"mresim: the run was stopped by signal {status - 128}; {where}")
             results = load(out)
         except BaseException:

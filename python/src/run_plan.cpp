@@ -81,14 +81,17 @@ class PythonRunPlan {
   }
 
   // Runs into `out` (created; an earlier mresim run there is replaced, anything else refused
-  // unless `force`) and returns `mresim run`'s exit status: 0, 3 (figures failed), 4 (invalid
-  // results, written and marked) or 128 + signal (stopped; a 3D run keeps its checkpoint).
-  int execute(const std::string& out, long threads, bool force, bool plot) const {
+  // unless `force`) and returns `mresim run`'s exit status, 0, 3 (figures failed), 4 (invalid
+  // results, written and marked) or 128 + signal (stopped; a 3D run keeps its checkpoint), and
+  // whether the results were published (also after a signal that came during a 3D run's last
+  // step: RunPlan::stops_at_own_safe_points).
+  std::pair<int, bool> execute(const std::string& out, long threads, bool force, bool plot) const {
     record_python_command_line();
     const py::gil_scoped_release computing;
     io::RunDirectory run_dir(out, io::RunDirectory::Options{force});
     const StopHandlersDuringRun stop_handlers;
-    return cli::execute_and_publish(root_, *plan_, run_type_, run_dir, threads, !plot);
+    const int status = cli::execute_and_publish(root_, *plan_, run_type_, run_dir, threads, !plot);
+    return {status, run_dir.committed()};
   }
 
  private:

@@ -43,7 +43,9 @@ int run_command(const RunOptions& options);
 
 // Shared by run and resume: executes the plan into run_dir's staging directory (results.h5
 // with the run's metadata), commits it and draws the figures. Returns the exit status; a stop
-// signal (stop_signal.hpp) ends it with 128 + the signal after keeping any checkpoint.
+// signal (stop_signal.hpp) ends it with 128 + the signal after keeping any checkpoint (or,
+// for a plan that stops at its own safe points and had finished, after publishing the
+// complete results without figures: RunPlan::stops_at_own_safe_points).
 // `job`: the MPI job of `mpirun -np P mresim run` (rank 0 calls this; docs/mpi.md).
 int execute_and_publish(const config::TableReader& root, const app::RunPlan& plan,
                         const std::string& run_type, io::RunDirectory& run_dir, long threads_option,

@@ -249,13 +249,16 @@ int execute_and_publish(const config::TableReader& root, const app::RunPlan& pla
     std::fflush(stdout);
   }
   // A stop signal after the plan's last safe point: the results above are complete (publishing
-  // them was quicker and safer than discarding hours of work); the figures are left out.
+  // them was quicker and safer than discarding hours of work); the figures are left out, and
+  // the run still ends as a stopped one (128 + the signal).
   const int late_signal = app::stop_signal();
   if (late_signal != 0) {
-    app::run_output().record(fmt::format(
-        "mresim: {} came after the last step; the results are complete in '{}', the figures were "
-        "not drawn (draw them with 'mresim plot {}')",
-        app::signal_name(late_signal), out.string(), out.string()));
+    app::run_output().error(fmt::format(
+        "mresim: {} came after the last step; the results are complete in '{}'{}",
+        app::signal_name(late_signal), out.string(),
+        no_plot ? std::string()
+                : fmt::format(", the figures were not drawn (draw them with 'mresim plot {}')",
+                              out.string())));
   }
   const int plot_status =
       no_plot || late_signal != 0 ? kSuccess : draw_figures(run_dir.final_path(), {}, quiet);
@@ -270,8 +273,9 @@ int execute_and_publish(const config::TableReader& root, const app::RunPlan& pla
         fmt::format("mresim: error: {}; the results in '{}' are kept with these entries marked "
                     "invalid",
                     invalid_results, out.string()));
-    return kInvalidResults;
+    return late_signal != 0 ? 128 + late_signal : kInvalidResults;
   }
+  if (late_signal != 0) return 128 + late_signal;
   return plot_status == kSuccess ? kSuccess : kPlotFailed;
 }
 

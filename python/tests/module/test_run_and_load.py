@@ -191,7 +191,7 @@ def test_the_gil_is_released_while_a_run_computes(tmp_path):
     spinner.start()
     time.sleep(0.01)
     start = time.perf_counter()
-    plan.execute(str(tmp_path / "run"), 1, False, False)
+    assert plan.execute(str(tmp_path / "run"), 1, False, False) == (0, True)
     # Taken after this thread has the GIL back: a spinner that only got it after the run
     # returned has samples just before `end`, none in the run's first half.
     end = time.perf_counter()

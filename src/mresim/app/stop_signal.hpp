@@ -7,9 +7,10 @@ namespace mresim::app {
 
 // SIGINT (Ctrl-C) and SIGTERM (what Slurm sends at the end of a job's time, or `scancel`) ask a
 // run to stop at its next safe point instead of dying mid-write. The 3D run types then write a
-// checkpoint and end with Interrupted{resumable = true}; run types without checkpoints end with
-// resumable = false and publish nothing. A second signal ends the process at once (the default
-// action), for a user who does not want to wait.
+// checkpoint and end with Interrupted{resumable = true} (a signal during their last step finds
+// no safe point left: their complete results are published, RunPlan::stops_at_own_safe_points);
+// run types without checkpoints end with resumable = false and publish nothing. A second signal
+// ends the process at once (the default action), for a user who does not want to wait.
 //
 // `mresim run`/`resume` exit with 128 + the signal number (130 for SIGINT, 143 for SIGTERM),
 // the shell's convention for "ended by this signal".

@@ -72,6 +72,8 @@ class RunDirectory {
   // computed, nothing is replaced: the results stay in the staging directory and
   // OutputDirectoryError says where.
   void commit();
+  // Whether commit() has published the results.
+  [[nodiscard]] bool committed() const { return committed_; }
 
   // The run was interrupted after writing a checkpoint: keep the staging directory (for
   // `mresim resume`) instead of removing it.
