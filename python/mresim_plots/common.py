@@ -1,6 +1,7 @@
 """Shared helpers: reading a run directory, styles, saving figures."""
 
 import csv
+import math
 import os
 import tomllib
 
@@ -34,6 +35,26 @@ PLOT_OPTION_DEFAULTS = dict(step=[], plane=[], particle=None, field_map=[], anim
 
 class PlotError(Exception):
     """A problem with the run directory, reported as one line."""
+
+
+def legend_below(fig, handles, labels, per_row, note="", fontsize=8, grow=False):
+    """A figure legend (and a grey note under it) in a strip kept free below the axes, for
+    legends too long to sit on an axes without covering the data (matplotlib 3.6, Debian 12,
+    has no loc="outside ..."). With grow the figure gets taller by the strip, so the axes keep
+    their size."""
+    rows = (math.ceil(len(labels) / per_row) if labels else 0) + (1 if note else 0)
+    strip_inches = 0.1 + 0.22 * rows
+    if grow:
+        fig.set_figheight(fig.get_figheight() + strip_inches)
+    height = fig.get_figheight()
+    strip = strip_inches / height
+    fig.get_layout_engine().set(rect=(0.0, strip, 1.0, 1.0 - strip))
+    if labels:
+        fig.legend(handles, labels, loc="lower center", ncol=per_row, fontsize=fontsize,
+                   frameon=False, bbox_to_anchor=(0.5, 0.2 / height if note else 0.0))
+    if note:
+        fig.text(0.5, 0.04 / height, note, ha="center", va="bottom", fontsize=fontsize,
+                 color="0.35")
 
 
 def case_colors(n):

@@ -40,7 +40,7 @@ import numpy as np
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle
 
-from .common import BRANCH_LINESTYLE, MAG_LABEL, PlotError, case_colors
+from .common import BRANCH_LINESTYLE, MAG_LABEL, PlotError, case_colors, legend_below
 from .loops import CONTACT_STYLE
 from .typography import UM_PAREN, suptitle, typeset
 
@@ -384,14 +384,18 @@ def energy_density_fit(run, data):
     if unfitted:
         handles.append(Line2D([], [], color="0.3", marker="o", markerfacecolor="none",
                               linestyle="none"))
-        labels.append("not fitted (zero strain above the next point, or after the kink)")
+        labels.append("not fitted (zero strain above the next point,\nor after the kink)")
     if not stress:
         handles.append(Line2D([], [], color="0.3", marker="o", markersize=4))
         labels.append(r"fit $u = a x^2/2 + c$ and its points")
     if second_drawn:
         handles.append(Line2D([], [], color="0.3", linestyle="--", marker="s", markersize=4))
-        labels.append(f"second fit after the kink, {data.second.formula()}, and its points")
-    ax.legend(handles, labels, fontsize=7, loc="upper left", ncol=2 if len(labels) > 8 else 1)
+        labels.append(f"second fit after the kink,\n{data.second.formula()}, and its points")
+    if len(labels) > 8:
+        # Many fields (the helix has twelve): below the axes, which it would otherwise cover.
+        legend_below(fig, handles, labels, per_row=2, fontsize=7, grow=True)
+    else:
+        ax.legend(handles, labels, fontsize=7, loc="upper left")
     ax.set_xlabel(strain_label(run, data))
     ax.set_ylabel(r"energy density $u - c$ (J/m$^3$)" if not stress
                   else r"energy density $u - u_{min}$ (J/m$^3$)")

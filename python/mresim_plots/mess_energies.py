@@ -20,7 +20,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.lines import Line2D
 
-from .common import case_colors
+from .common import case_colors, legend_below
 from .typography import suptitle
 from .mess import (ABS_FIELD_LABEL, ENERGY_PANELS, FIELD_MT_LABEL, draw_legs,
                    leg_legend_handles, legs, strain_label)
@@ -184,17 +184,8 @@ def _finish(run, fig, axes, panels, xlabel, ylabel, handles, note):
 
 
 def _figure_legend(fig, handles, note=""):
-    """The legend and the note in a strip below the axes (matplotlib 3.6 has no
-    loc='outside ...')."""
+    """The legend and the note in a strip below the axes, four entries per row."""
     if not handles and not note:
         return
     per_row = min(max(len(handles), 1), 4)
-    rows = math.ceil(len(handles) / per_row) + (1 if note else 0)
-    strip = (0.1 + 0.22 * rows) / fig.get_figheight()
-    fig.get_layout_engine().set(rect=(0.0, strip, 1.0, 1.0 - strip))
-    if handles:
-        fig.legend(handles=handles, loc="lower center", ncol=per_row, fontsize=8, frameon=False,
-                   bbox_to_anchor=(0.5, 0.2 / fig.get_figheight() if note else 0.0))
-    if note:
-        fig.text(0.5, 0.04 / fig.get_figheight(), note, ha="center", va="bottom", fontsize=8,
-                 color="0.35")
+    legend_below(fig, handles, [h.get_label() for h in handles], per_row, note)

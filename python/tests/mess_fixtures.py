@@ -178,12 +178,12 @@ def make_magnetostriction(directory, positions="results"):
                      magnetizations(m_along), positions=positions)
 
 
-def make_strain(directory, positions="files", mr_nan=False, invalid_field=None):
-    """Simple shear 0 .. 0.1 rad at 4 fields; at the largest field the energy density drops at
-    the 8th strain (clustering), so only 7 points are fitted. invalid_field: the index of a
-    field whose fit is marked invalid (/analysis/valid = 0, only 2 points) while its modulus
-    stays a finite number, as mresim writes it."""
-    fields = np.array([0.0, 0.02, 0.05, 0.1])
+def make_strain(directory, positions="files", mr_nan=False, invalid_field=None, fields=None):
+    """Simple shear 0 .. 0.1 rad at 4 fields (or at `fields`, in T); at the largest field the
+    energy density drops at the 8th strain (clustering), so only 7 points are fitted.
+    invalid_field: the index of a field whose fit is marked invalid (/analysis/valid = 0, only 2
+    points) while its modulus stays a finite number, as mresim writes it."""
+    fields = np.array([0.0, 0.02, 0.05, 0.1] if fields is None else fields)
     gammas = np.linspace(0.0, 0.1, 11)
     moduli = 4e3 * (1 + 0.4 * np.arange(fields.size) ** 1.5)
     offsets = -300.0 * fields / 0.1

@@ -271,6 +271,34 @@ class MessFigureDataTest(unittest.TestCase):
         np.testing.assert_allclose(diamonds[0].get_xdata(), [data.field_magnitude[k] * 1e3])
         np.testing.assert_allclose(diamonds[0].get_ydata(), [expected["modulus"] / 1e3])
 
+    def test_a_legend_of_twelve_fields_goes_below_the_axes_inside_the_figure(self):
+        # The Fig. 4.25 helix has twelve fields: on the axes their legend covered the curves and
+        # ran past the figure's right edge.
+        d = self.strain_run("twelve", fields=np.linspace(0.0, 0.14, 12))
+        mess_fixtures.add_second_fit(d)
+        run = KeptFigures(d)
+        data = mess.MessData(run)
+        mess.energy_density_fit(run, data)
+        fig = run.figures["energy_density_fit.png"]
+        ax = fig.axes[0]
+        self.assertIsNone(ax.get_legend())
+        self.assertEqual(len(fig.legends), 1)
+        legend = fig.legends[0]
+        labels = [t.get_text() for t in legend.get_texts()]
+        for k in range(12):
+            self.assertEqual(sum(t.startswith(data.field_label(k) + ":") for t in labels), 1,
+                             labels)
+        self.assertTrue(any(t.startswith("second fit after the kink") for t in labels), labels)
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        box = legend.get_window_extent(renderer)
+        page = fig.bbox
+        self.assertGreaterEqual(box.x0, page.x0)
+        self.assertLessEqual(box.x1, page.x1)
+        self.assertGreaterEqual(box.y0, page.y0)
+        # below the axes with their tick labels and axis label, so it covers no data
+        self.assertLessEqual(box.y1, ax.get_tightbbox(renderer).y0)
+
     def test_second_fit_with_a_stored_slope(self):
         run, data, expected = self.second_fit_figures("second_slope", slope=-40.0)
         ax = run.figures["energy_density_fit.png"].axes[0]
