@@ -263,11 +263,24 @@ std::vector<pid_t> children_of(pid_t parent) {
   return children;
 }
 
-// SIGTERM to every process of the job, as a scheduler stops one (Slurm signals the tasks): both
-// stop at the same step boundary and process 0 writes the checkpoint; `mpirun -np 2 mresim
-// resume` continues it, the other process reading the same checkpoint, to results bitwise
-// those of an uninterrupted two-process run. (A signal to mpirun itself reaches the processes
-// too, but OpenMPI kills them a second later, before a long step ends: docs/cli.md.)
+// The MPI rank of a process started by OpenMPI's mpirun (its environment names it), -1 if none.
+int rank_of(pid_t pid) {
+  std::string environment = read_text(fs::path("/proc") / std::to_string(pid) / "environ");
+  std::replace(environment.begin(), environment.end(), '\0', '\n');
+  std::istringstream lines(environment);
+  const std::string key = "OMPI_COMM_WORLD_RANK=";
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind(key, 0) == 0) return std::stoi(line.substr(key.size()));
+  }
+  return -1;
+}
+
+// SIGTERM to one process of the job, the one that is not rank 0 (a scheduler signals every
+// task, a user may signal one): both stop at the same step boundary, rank 0 names the signal
+// it did not receive itself and writes the checkpoint; `mpirun -np 2 mresim resume` continues
+// it, the other process reading the same checkpoint, to results bitwise those of an
+// uninterrupted two-process run. (A signal to mpirun itself reaches the processes too, but
+// OpenMPI kills them a second later, before a long step ends: docs/cli.md.)
 TEST(MpiRunCli, StoppedRunResumesOverProcessesToTheSameResults) {
   if (!have_mpirun()) GTEST_SKIP() << "no MPI launcher (mpirun) found";
   const TempDir dir;
@@ -299,7 +312,13 @@ TEST(MpiRunCli, StoppedRunResumesOverProcessesToTheSameResults) {
   }
   const std::vector<pid_t> processes = children_of(pid);
   ASSERT_EQ(processes.size(), 2U);
-  for (const pid_t p : processes) ::kill(p, SIGTERM);
+  std::vector<int> ranks;
+  for (const pid_t p : processes) ranks.push_back(rank_of(p));
+  std::sort(ranks.begin(), ranks.end());
+  ASSERT_EQ(ranks, (std::vector<int>{0, 1}));
+  for (const pid_t p : processes) {
+    if (rank_of(p) == 1) ::kill(p, SIGTERM);
+  }
   EXPECT_NE(mresim::testing::wait_child(pid), 0);
   const std::string err = read_text(dir / ".stderr-bg");
   ASSERT_NE(err.find("mresim: interrupted by SIGTERM after step "), std::string::npos) << err;

@@ -27,12 +27,13 @@ MpiJob mpi_job() {
   return job;
 }
 
-bool any_process(bool flag) {
-  if (mpi_job().size == 1) return flag;
-  int mine = flag ? 1 : 0;
-  int any = 0;
-  MPI_Allreduce(&mine, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  return any != 0;
+bool any_process(bool flag) { return largest_over_processes(flag ? 1 : 0) != 0; }
+
+int largest_over_processes(int value) {
+  if (mpi_job().size == 1) return value;
+  int largest = 0;
+  MPI_Allreduce(&value, &largest, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  return largest;
 }
 
 std::string broadcast_text(const std::string& text) {

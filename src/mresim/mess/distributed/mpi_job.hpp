@@ -21,9 +21,14 @@ bool started_by_mpi_launcher();
 // case MPI (with PETSc) is started now if it was not yet.
 MpiJob mpi_job();
 
-// Whether every process of the job has `flag` set (collective when the job has more than one
+// Whether any process of the job has `flag` set (collective when the job has more than one
 // process: all must call it at the same point).
 bool any_process(bool flag);
+
+// The largest of the processes' `value`s (collective as any_process). A stop signal that
+// reached only some processes is known to all by its number: largest_over_processes(
+// app::stop_signal()).
+int largest_over_processes(int value);
 
 // Collective: rank 0's `text` on every process (unchanged when the job has one process).
 std::string broadcast_text(const std::string& text);

@@ -109,10 +109,12 @@ class MessPlan final : public app::RunPlan {
       // SIGINT/SIGTERM: a step boundary is the safe point; checkpoint (whatever checkpoint_every
       // says) so that `mresim resume` continues from here. Over MPI processes all stop at the
       // same step (participate() asks at the same point).
-      const bool stop = split ? mess::any_process(app::stop_requested()) : app::stop_requested();
-      if (stop && state.next_step < total) {
+      // The signal may have reached only some of them: all learn its number.
+      const int signal =
+          split ? mess::largest_over_processes(app::stop_signal()) : app::stop_signal();
+      if (signal != 0 && state.next_step < total) {
         write_checkpoint(checkpoint, state, runner, input_toml_, input_name_);
-        throw app::Interrupted(app::stop_signal(), true,
+        throw app::Interrupted(signal, true,
                                fmt::format("after step {} of {}", state.next_step, total));
       }
     }
@@ -154,7 +156,9 @@ class MessPlan final : public app::RunPlan {
     const std::size_t total = runner.steps().size();
     while (state.next_step < total) {
       (void)runner.run_next_step(state);
-      if (mess::any_process(app::stop_requested()) && state.next_step < total) return;
+      if (mess::largest_over_processes(app::stop_signal()) != 0 && state.next_step < total) {
+        return;
+      }
     }
   }
 
