@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -23,6 +24,7 @@ namespace {
 namespace fs = std::filesystem;
 using mresim::testing::TempDir;
 using testing::spec_of;
+using testing::three_field_shear;
 
 bool directory_is_empty(const fs::path& dir) {
   return fs::directory_iterator(dir) == fs::directory_iterator();
@@ -74,37 +76,35 @@ TEST(KeptPositions, ParksLoadsAndTakesTheSameArray) {
   EXPECT_EQ(spill->records(), 0);
 
   KeptPositions kept = x;
+  EXPECT_EQ(none.version(), 0U);
+  const std::uint64_t version = kept.version();
+  EXPECT_NE(version, 0U);
   EXPECT_FALSE(kept.parked());
   kept.park(spill);
   EXPECT_TRUE(kept.parked());
+  EXPECT_EQ(kept.version(), version);  // the same value, parked
   EXPECT_EQ(kept.cols(), 50);
   EXPECT_EQ(kept.load(), x);
   EXPECT_EQ(spill->records(), 1);
   {
     // A copy shares the record; the record stays while any copy holds it.
     KeptPositions copy = kept;
+    EXPECT_EQ(copy.version(), version);
     EXPECT_EQ(copy.load(), x);
     EXPECT_EQ(copy.take(), x);
     EXPECT_EQ(copy.cols(), 0);
+    EXPECT_EQ(copy.version(), 0U);
   }
   EXPECT_EQ(kept.load(), x);
   // Assigning a new array lets the record go: the next park reuses it.
   kept = Eigen::Matrix3Xd(2.0 * x);
+  EXPECT_NE(kept.version(), version);  // a new value: a checkpoint writes it again
   EXPECT_FALSE(kept.parked());
   kept.park(spill);
   EXPECT_EQ(spill->records(), 1);
   EXPECT_EQ(kept.take(), 2.0 * x);
   EXPECT_EQ(kept.cols(), 0);
   EXPECT_FALSE(kept.parked());
-}
-
-// Three fields x three shear strains: the steps go through the fields at each strain, so each
-// field's latest state and zero-load reference wait while the others relax.
-std::string three_field_shear() {
-  return std::string("[run]\ntype = \"mess_strain\"\n") + testing::kSmallModel +
-         "\n[field]\nmagnitudes = [0.0, 0.05, 0.1]\n"
-         "\n[strain]\nkind = \"shear\"\nnormal = \"z\"\ndirection = \"x\"\n"
-         "max = 0.02\nsteps = 2\n";
 }
 
 void expect_same_records(const ProtocolState& a, const ProtocolState& b) {

@@ -32,6 +32,15 @@ inline std::string small_hysteresis(double max_tesla, int steps, int checkpoint_
          "\n\n[output]\ncheckpoint_every = " + std::to_string(checkpoint_every) + "\n";
 }
 
+// mess_strain at three fields x three shear strains: the steps go through the fields at each
+// strain, so each field's latest state and zero-load reference wait while the others relax.
+inline std::string three_field_shear() {
+  return std::string("[run]\ntype = \"mess_strain\"\n") + kSmallModel +
+         "\n[field]\nmagnitudes = [0.0, 0.05, 0.1]\n"
+         "\n[strain]\nkind = \"shear\"\nnormal = \"z\"\ndirection = \"x\"\n"
+         "max = 0.02\nsteps = 2\n";
+}
+
 inline mess_config::MessSpec spec_of(const std::string& toml) {
   return mess_config::read_mess_run_file(config::TableReader::parse_string(toml, "test.toml"));
 }

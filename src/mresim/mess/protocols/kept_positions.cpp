@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
@@ -104,9 +105,15 @@ struct KeptPositions::Record {
   std::int64_t number;
 };
 
+std::uint64_t KeptPositions::new_version(const Eigen::Matrix3Xd& x) {
+  static std::atomic<std::uint64_t> last{0};
+  return x.cols() == 0 ? 0 : ++last;
+}
+
 KeptPositions& KeptPositions::operator=(Eigen::Matrix3Xd x) {
   record_.reset();
   memory_ = std::move(x);
+  version_ = new_version(memory_);
   return *this;
 }
 
@@ -123,6 +130,7 @@ Eigen::Matrix3Xd KeptPositions::take() {
   Eigen::Matrix3Xd x = record_ ? load() : std::move(memory_);
   record_.reset();
   memory_.resize(3, 0);
+  version_ = 0;
   return x;
 }
 

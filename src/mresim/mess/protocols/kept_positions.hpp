@@ -59,9 +59,13 @@ class KeptPositions {
  public:
   KeptPositions() = default;
   KeptPositions(Eigen::Matrix3Xd x)  // NOLINT(google-explicit-constructor): a value like x
-      : memory_(std::move(x)) {}
+      : memory_(std::move(x)), version_(new_version(memory_)) {}
   KeptPositions& operator=(Eigen::Matrix3Xd x);
 
+  // Names the array's value: a new number, unique in the process, for each array given to it
+  // (the constructor, assignment), shared by its copies and kept by park(); 0 when there is
+  // none. A checkpoint rewrites an array only when its number changed (CheckpointWriter).
+  [[nodiscard]] std::uint64_t version() const { return version_; }
   // Columns (nodes) of the array, parked or not; 0 when there is none.
   [[nodiscard]] Eigen::Index cols() const;
   [[nodiscard]] bool parked() const { return record_ != nullptr; }
@@ -75,8 +79,12 @@ class KeptPositions {
 
  private:
   struct Record;
+  // A new version() for `x`, 0 for no array.
+  static std::uint64_t new_version(const Eigen::Matrix3Xd& x);
+
   Eigen::Matrix3Xd memory_;
   std::shared_ptr<const Record> record_;
+  std::uint64_t version_ = 0;
 };
 
 }  // namespace mresim::mess_protocol

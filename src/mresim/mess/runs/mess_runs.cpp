@@ -71,10 +71,11 @@ class MessPlan final : public app::RunPlan {
     // Strain and stress runs keep the fields they are not working on in an unnamed scratch
     // file beside the results (kept_positions.hpp), not in memory.
     runner.set_scratch_directory(staging_dir);
-    const fs::path checkpoint = staging_dir / kCheckpointFile;
+    // Each checkpoint writes only the node arrays that changed (checkpoint.hpp).
+    CheckpointWriter checkpoints(staging_dir);
     const bool split = split_over_processes(runner);
-    ProtocolState state = fs::exists(checkpoint) ? read_checkpoint(checkpoint, runner, input_toml_)
-                                                 : runner.initial_state();
+    ProtocolState state =
+        checkpoints.exists() ? checkpoints.read(runner, input_toml_) : runner.initial_state();
     const std::size_t total = runner.steps().size();
     if (state.next_step > 0) {
       progress.note(fmt::format("mresim: resuming at step {} of {} from the checkpoint",
@@ -104,7 +105,7 @@ class MessPlan final : public app::RunPlan {
       }
       if (every > 0 && state.next_step < total &&
           state.next_step % static_cast<std::size_t>(every) == 0) {
-        write_checkpoint(checkpoint, state, runner, input_toml_, input_name_);
+        checkpoints.write(state, runner, input_toml_, input_name_);
       }
       // SIGINT/SIGTERM: a step boundary is the safe point; checkpoint (whatever checkpoint_every
       // says) so that `mresim resume` continues from here. Over MPI processes all stop at the
@@ -113,7 +114,7 @@ class MessPlan final : public app::RunPlan {
       const int signal =
           split ? mess::largest_over_processes(app::stop_signal()) : app::stop_signal();
       if (signal != 0 && state.next_step < total) {
-        write_checkpoint(checkpoint, state, runner, input_toml_, input_name_);
+        checkpoints.write(state, runner, input_toml_, input_name_);
         throw app::Interrupted(signal, true,
                                fmt::format("after step {} of {}", state.next_step, total));
       }
@@ -133,8 +134,7 @@ class MessPlan final : public app::RunPlan {
     if (spec_.output.keep_final_state) {
       write_checkpoint(staging_dir / kFinalStateFile, state, runner, input_toml_, input_name_);
     }
-    std::error_code ec;
-    fs::remove(checkpoint, ec);
+    checkpoints.remove();
     // Non-finite or unconverged steps: the results stay, marked; `mresim run` exits with 4.
     const std::string invalid = check.message();
     if (!invalid.empty()) throw app::InvalidResults(invalid);
