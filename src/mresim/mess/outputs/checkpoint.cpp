@@ -240,7 +240,7 @@ void remove_unnamed(const fs::path& directory, const std::set<std::string>& name
   if (!fs::is_directory(directory, ec)) return;
   std::vector<fs::path> stale;
   for (const auto& entry : fs::directory_iterator(directory, ec)) {
-    if (entry.is_regular_file(ec) && named.count(entry.path().filename().string()) == 0) {
+    if (entry.is_regular_file(ec) && !named.contains(entry.path().filename().string())) {
       stale.push_back(entry.path());
     }
   }
@@ -288,7 +288,7 @@ void CheckpointWriter::write(const ProtocolState& state, const ProtocolRunner& r
       return;
     }
     std::string name = fmt::format("{}-{}.h5", file_tag(path), state.next_step);
-    for (int k = 2; in_use.count(name) != 0; ++k) {
+    for (int k = 2; in_use.contains(name); ++k) {
       name = fmt::format("{}-{}-{}.h5", file_tag(path), state.next_step, k);
     }
     write_replacing(arrays / name,
