@@ -12,6 +12,7 @@
 #include <string>
 
 #include "../../support/temp_dir.hpp"
+#include "../support/checkpoint_round_trip.hpp"
 #include "../support/small_runs.hpp"
 #include "mresim/mess/outputs/checkpoint.hpp"
 #include "mresim/mess/protocols/protocol_runner.hpp"
@@ -22,6 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 using mresim::testing::TempDir;
 using mresim::testing::write_text;
+using testing::expect_same_states;
 using testing::spec_of;
 using testing::three_field_shear;
 
@@ -40,22 +42,18 @@ std::set<std::string> named_files(const CheckpointWriter& writer) {
   return names;
 }
 
-void expect_same_steps(const ProtocolState& a, const ProtocolState& b) {
-  ASSERT_EQ(a.records.size(), b.records.size());
-  for (std::size_t i = 0; i < a.records.size(); ++i) {
-    EXPECT_EQ(a.records[i].energies.total(), b.records[i].energies.total()) << "step " << i;
-    EXPECT_EQ(a.records[i].centres, b.records[i].centres) << "step " << i;
-    EXPECT_EQ(a.records[i].magnetization, b.records[i].magnetization) << "step " << i;
-    EXPECT_EQ(a.records[i].iterations, b.records[i].iterations) << "step " << i;
-  }
+// The run of `spec` from start to end in one go, in memory.
+ProtocolState uninterrupted_run(const mess_config::MessSpec& spec) {
+  ProtocolRunner runner(spec);
+  ProtocolState state = runner.initial_state();
+  runner.run(state, nullptr);
+  return state;
 }
 
 TEST(CheckpointWriter, WritesOnlyTheArraysThatChangedAndResumesToTheSameResults) {
   const std::string toml = three_field_shear();
   const mess_config::MessSpec spec = spec_of(toml);
-  ProtocolRunner uninterrupted(spec);
-  ProtocolState expected = uninterrupted.initial_state();
-  uninterrupted.run(expected, nullptr);
+  const ProtocolState expected = uninterrupted_run(spec);
   ASSERT_EQ(expected.records.size(), 9U);
 
   const TempDir dir;
@@ -114,7 +112,7 @@ TEST(CheckpointWriter, WritesOnlyTheArraysThatChangedAndResumesToTheSameResults)
   }
   EXPECT_EQ(kept, 5U);
   second.run(state, [&](const ProtocolState& s) { writer.write(s, second, toml, "test.toml"); });
-  expect_same_steps(expected, state);
+  expect_same_states(expected, state);
   EXPECT_EQ(files_in(arrays), named_files(writer));
 
   writer.remove();
@@ -127,9 +125,7 @@ TEST(CheckpointWriter, ResumesFromACheckpointOfThePreviousFormat) {
   // Format 2 held every array inside the checkpoint file; a run interrupted under it resumes.
   const std::string toml = three_field_shear();
   const mess_config::MessSpec spec = spec_of(toml);
-  ProtocolRunner uninterrupted(spec);
-  ProtocolState expected = uninterrupted.initial_state();
-  uninterrupted.run(expected, nullptr);
+  const ProtocolState expected = uninterrupted_run(spec);
 
   const TempDir dir;
   const fs::path file = dir / kCheckpointFile;
@@ -154,7 +150,7 @@ TEST(CheckpointWriter, ResumesFromACheckpointOfThePreviousFormat) {
   ASSERT_EQ(state.next_step, 4U);
   EXPECT_TRUE(writer.array_files().empty());  // every array was inside the file
   second.run(state, [&](const ProtocolState& s) { writer.write(s, second, toml, "test.toml"); });
-  expect_same_steps(expected, state);
+  expect_same_states(expected, state);
 }
 
 }  // namespace

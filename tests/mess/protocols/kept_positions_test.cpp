@@ -14,6 +14,7 @@
 #include <string>
 
 #include "../../support/temp_dir.hpp"
+#include "../support/checkpoint_round_trip.hpp"
 #include "../support/small_runs.hpp"
 #include "mresim/mess/outputs/checkpoint.hpp"
 #include "mresim/mess/protocols/protocol_runner.hpp"
@@ -23,6 +24,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using mresim::testing::TempDir;
+using testing::expect_same_states;
 using testing::spec_of;
 using testing::three_field_shear;
 
@@ -107,22 +109,6 @@ TEST(KeptPositions, ParksLoadsAndTakesTheSameArray) {
   EXPECT_FALSE(kept.parked());
 }
 
-void expect_same_records(const ProtocolState& a, const ProtocolState& b) {
-  ASSERT_EQ(a.records.size(), b.records.size());
-  for (std::size_t i = 0; i < a.records.size(); ++i) {
-    EXPECT_EQ(a.records[i].energies.total(), b.records[i].energies.total()) << "step " << i;
-    EXPECT_EQ(a.records[i].centres, b.records[i].centres) << "step " << i;
-    EXPECT_EQ(a.records[i].magnetization, b.records[i].magnetization) << "step " << i;
-    EXPECT_EQ(a.records[i].measured_strain, b.records[i].measured_strain) << "step " << i;
-    EXPECT_EQ(a.records[i].iterations, b.records[i].iterations) << "step " << i;
-  }
-  ASSERT_EQ(a.slots.size(), b.slots.size());
-  for (std::size_t f = 0; f < a.slots.size(); ++f) {
-    EXPECT_EQ(a.slots[f].positions.load(), b.slots[f].positions.load()) << "field " << f;
-    EXPECT_EQ(a.references[f].load(), b.references[f].load()) << "field " << f;
-  }
-}
-
 TEST(KeptPositions, AStrainRunThatParksItsFieldsGivesTheSameResults) {
   const std::string toml = three_field_shear();
   const mess_config::MessSpec spec = spec_of(toml);
@@ -152,7 +138,7 @@ TEST(KeptPositions, AStrainRunThatParksItsFieldsGivesTheSameResults) {
   // Two arrays per field at most, and the file is not in the directory.
   EXPECT_LE(parked.spill->records(), 6);
   EXPECT_TRUE(directory_is_empty(dir.path()));
-  expect_same_records(held, parked);
+  expect_same_states(held, parked);
 
   // Resumed after step 4 from a checkpoint, parking again: the same results.
   const fs::path checkpoint = dir / "checkpoint.h5";
@@ -171,7 +157,7 @@ TEST(KeptPositions, AStrainRunThatParksItsFieldsGivesTheSameResults) {
     EXPECT_EQ(slot.positions.parked(), slot.positions.cols() > 0);  // parked as read
   }
   second.run(resumed, nullptr);
-  expect_same_records(held, resumed);
+  expect_same_states(held, resumed);
 }
 
 }  // namespace
