@@ -24,7 +24,7 @@ namespace mresim::mess_protocol {
 namespace {
 
 // 0, 4, 8 mT along the pair's axis, 7 um apart: the pair moves by about 25 nm per step, less
-// than the default distance of 0.1 lattice spacings (100 nm) from the first step's start.
+// than a distance of 0.1 lattice spacings (100 nm) from the first step's start.
 std::string large_box_field_steps(double reuse) {
   std::string model = testing::kSmallModel;
   const std::string box = "size = [9e-6, 9e-6, 17e-6]";
@@ -63,6 +63,15 @@ TEST(PreconditionerReuse, KeptStepsReachTheSameMinimaAndAResumedRunKeepsThemBitF
   for (std::size_t i = 0; i < kept.size(); ++i) {
     EXPECT_EQ(resumed.records[i].preconditioner, kept[i].preconditioner) << "step " << i;
   }
+}
+
+// The default distance, 0.3 lattice spacings (measured on the full-size helix and Fig. 4.11
+// loop, docs/performance.md), is the run files' and the minimiser's alike.
+TEST(PreconditionerReuse, DefaultIsThreeTenthsOfALatticeSpacing) {
+  std::string toml = large_box_field_steps(0.1);
+  toml.erase(toml.find("\n[solver]"));
+  EXPECT_EQ(testing::spec_of(toml).solver.preconditioner_reuse, 0.3);
+  EXPECT_EQ(mess::MinimiserOptions{}.preconditioner_reuse, 0.3);
 }
 
 }  // namespace

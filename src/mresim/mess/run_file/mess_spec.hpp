@@ -194,8 +194,9 @@ struct SolverSpec {
   mess::ContactGap contact_gap = mess::ContactGap::exact;
   // method = "minimiser" only: the largest node displacement (lattice spacings) from the state
   // that preconditioner was built at up to which a step keeps it (solvers/preconditioner_cache
-  // .hpp); 0: built at every step's start.
-  double preconditioner_reuse = 0.1;
+  // .hpp); 0: built at every step's start. 0.3: measured on the full-size helix and Fig. 4.11
+  // loop (docs/performance.md, "Routes measured for the helix's remaining 1.7x").
+  double preconditioner_reuse = 0.3;
   MinimiserSettings minimiser;
   LeapfrogSettings leapfrog;
   // atol, rtol, iteration budgets; `demagnetization` mirrors MessSpec::demagnetization.

@@ -160,8 +160,9 @@ struct MinimiserOptions {
   std::shared_ptr<PreconditionerCache> preconditioner_cache;
   // With the multilevel preconditioner and a cache: the largest node displacement, in lattice
   // spacings, from the state the kept preconditioner was built at up to which a call keeps it
-  // (preconditioner_cache.hpp); 0: built anew at every call's start.
-  double preconditioner_reuse = 0.1;
+  // (preconditioner_cache.hpp); 0: built anew at every call's start. The run files' default
+  // (SolverSpec) sets it for every 3D run.
+  double preconditioner_reuse = 0.3;
   double max_step = 0.2;  // largest coordinate change per iteration, in units of l_e
   // Seed profile, lbfgs: inexact defect correction. The conservative phase stops once its
   // largest force is below correction_forcing x the largest difference between the seed's and
