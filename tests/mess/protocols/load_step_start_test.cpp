@@ -1,6 +1,7 @@
 // Where a strain run's loaded steps start (protocols/load_step_start.hpp): the predictions'
 // formulas, and on a small shear run that the predicted starts reach the same states as the
-// original's start in fewer iterations, are recorded per step, and resume bit for bit.
+// original's start in fewer iterations, are recorded per step, keep the point their next secant
+// passes through, and resume bit for bit.
 
 #include "mresim/mess/protocols/load_step_start.hpp"
 
@@ -171,13 +172,49 @@ TEST(LoadStepStart, ResumedFromACheckpointEqualsTheUninterruptedRun) {
   const mess_config::MessSpec spec = spec_of(toml);
   const std::vector<StepRecord> full = testing::records_of_run(toml);
 
-  const mresim::testing::TempDir dir;
-  const auto checkpoint = dir / "checkpoint.h5";
-  ProtocolRunner second(spec);
-  // Interrupted before the neighbour-field step 3 and the secant steps after it.
-  ProtocolState resumed = testing::resumed_after(toml, 3, checkpoint, second);
-  second.run(resumed, nullptr);
-  testing::expect_same_records(resumed.records, full);
+  // Interrupted before the neighbour-field step 3 and the secant steps after it; and before
+  // step 7, the second field's third strain, whose secant and those after it pass through
+  // the checkpoint's results two strains back (ProtocolState::earlier_load_results).
+  for (const std::size_t done : {3U, 7U}) {
+    const mresim::testing::TempDir dir;
+    ProtocolRunner second(spec);
+    ProtocolState resumed = testing::resumed_after(toml, done, dir / "checkpoint.h5", second);
+    if (done == 7) {
+      ASSERT_EQ(resumed.earlier_load_results.size(), 2U);
+      EXPECT_GT(resumed.earlier_load_results[0].cols(), 0);
+      EXPECT_GT(resumed.earlier_load_results[1].cols(), 0);
+    }
+    second.run(resumed, nullptr);
+    testing::expect_same_records(resumed.records, full);
+  }
+}
+
+// From the third strain on, a step's secant passes through its field's result two strains back
+// (x_{k-2}, not the zero-strain state): each loaded step keeps its start, the field's result at
+// the strain before, for the field's next strain. Through the zero-strain state, a contact
+// formed at an earlier strain would be carried on (the Fig. 4.25 helix at 10 and 20 mT).
+TEST(LoadStepStart, EachLoadedStepKeepsItsStartForTheFieldsNextSecant) {
+  const mess_config::MessSpec spec = spec_of(small_shear(""));
+  ProtocolRunner runner(spec);
+  ASSERT_TRUE(runner.keeps_earlier_load_results());
+  ProtocolState state = runner.initial_state();
+  ASSERT_EQ(state.earlier_load_results.size(), 2U);
+  while (state.next_step < runner.steps().size()) {
+    const StepSpec& step = runner.steps()[state.next_step];
+    const Eigen::Matrix3Xd start = state.slots[step.field_index].positions.load();
+    runner.run_next_step(state);
+    if (step.load_index == 0) {
+      EXPECT_EQ(state.earlier_load_results[step.field_index].cols(), 0) << state.next_step;
+      continue;
+    }
+    ASSERT_GT(start.cols(), 0);
+    EXPECT_TRUE(state.earlier_load_results[step.field_index].load() == start)
+        << "step " << state.next_step - 1;
+  }
+  // "previous" keeps none.
+  const ProtocolRunner original(spec_of(small_shear("previous")));
+  EXPECT_FALSE(original.keeps_earlier_load_results());
+  EXPECT_TRUE(original.initial_state().earlier_load_results.empty());
 }
 
 }  // namespace

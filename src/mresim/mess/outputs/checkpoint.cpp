@@ -52,6 +52,9 @@ void for_each_kept_array(State& state, Visit&& visit) {
     visit(fmt::format("/references/{}", i), state.references[i]);
   }
   visit(std::string(kEarlierFieldResult), state.earlier_field_result);
+  for (std::size_t i = 0; i < state.earlier_load_results.size(); ++i) {
+    visit(fmt::format("/earlier_load_results/{}", i), state.earlier_load_results[i]);
+  }
 }
 
 void write_optional(io::Hdf5File& file, const std::string& path, const Eigen::Matrix3Xd& m,

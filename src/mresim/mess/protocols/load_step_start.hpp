@@ -13,9 +13,13 @@
 // strain coordinate c in which the moved faces move linearly (Protocol::measured_strain: tan
 // gamma for shear, the engineering strain, the twist angle):
 //
-//  - k >= 2: the secant through the zero-strain state x_0 at the same field,
-//        x = x_{k-1} + (c_k - c_{k-1}) / (c_{k-1} - c_0) (x_{k-1} - x_0),
-//    exact where the response is linear in c (secant_start);
+//  - k >= 2: the secant through the field's result two load values back (the zero-strain state
+//    x_0 at k = 2; ProtocolState::earlier_load_results keeps it),
+//        x = x_{k-1} + (c_k - c_{k-1}) / (c_{k-1} - c_{k-2}) (x_{k-1} - x_{k-2}),
+//    exact where the response is linear in c between them (secant_start). Through x_0 at every
+//    k (the form before) it carried a contact formed at an earlier strain on: on the Fig. 4.25
+//    helix at 10 and 20 mT it put two particles 170 nm into each other, and such steps took
+//    2.7-3.1x the iterations (docs/performance.md, "The helix's 10 and 20 mT strain steps");
 //  - k = 1 at a field f >= 1: the zero-strain state plus the previous field's response at the
 //    same strain, x = x_0(f) + (x_1(f - 1) - x_0(f - 1)) (neighbour_field_start);
 //  - k = 1 at the first field: the previous state (nothing to extrapolate from).
@@ -53,9 +57,10 @@ inline const std::string kFieldSecant = "field_secant";
 inline const std::string kPredictionRejected = "previous_prediction_rejected";
 }  // namespace step_start
 
-// x_{k-1} + (c - c_previous) / (c_previous - c_zero) (x_{k-1} - x_0). Throws
-// std::invalid_argument if the arrays differ in size, a coordinate is not finite or c_previous ==
-// c_zero.
+// x_{k-1} + (c - c_previous) / (c_previous - c_zero) (x_{k-1} - x_0), x_0 (`zero_load`, at
+// strain c_zero) the secant's earlier point: the zero-strain state, or the result two load
+// values back. Throws std::invalid_argument if the arrays differ in size, a coordinate is not
+// finite or c_previous == c_zero.
 Eigen::Matrix3Xd secant_start(const Eigen::Matrix3Xd& previous, const Eigen::Matrix3Xd& zero_load,
                               double c, double c_previous, double c_zero);
 

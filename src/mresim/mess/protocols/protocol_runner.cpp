@@ -68,6 +68,7 @@ ProtocolState ProtocolRunner::initial_state() const {
   const std::size_t fields = spec_.field.values.size();
   state.slots.resize(spec_.load_step_count() > 1 ? fields : 1);
   state.references.resize(spec_.load_step_count() > 1 ? fields : 0);
+  state.earlier_load_results.resize(keeps_earlier_load_results() ? fields : 0);
   return state;
 }
 
@@ -78,6 +79,7 @@ void ProtocolRunner::park_kept_positions(ProtocolState& state) const {
   }
   for (SlotState& slot : state.slots) slot.positions.park(state.spill);
   for (KeptPositions& reference : state.references) reference.park(state.spill);
+  for (KeptPositions& earlier : state.earlier_load_results) earlier.park(state.spill);
 }
 
 const SlotState* ProtocolRunner::start_state(const StepSpec& step,
@@ -140,6 +142,11 @@ const StepSpec& ProtocolRunner::step_at(std::size_t field_index, std::size_t loa
                          " and load value " + std::to_string(load_index));
 }
 
+bool ProtocolRunner::keeps_earlier_load_results() const {
+  return spec_.solver.load_step_start == mc::LoadStepStart::extrapolated &&
+         spec_.load_step_count() > 1 && spec_.protocol->loads_from_zero_load_state();
+}
+
 bool ProtocolRunner::keeps_earlier_field_result() const {
   return spec_.solver.field_step_start == mc::FieldStepStart::extrapolated &&
          spec_.load_step_count() <= 1;
@@ -185,11 +192,22 @@ std::string ProtocolRunner::predict_start(const StepSpec& step, const ProtocolSt
   std::string kind;
   if (step.load_index >= 2) {
     const StepSpec& previous = step_at(step.field_index, step.load_index - 1);
-    const StepSpec& zero = step_at(step.field_index, 0);
     const Eigen::Matrix3Xd& x = system_.positions();
-    candidate = secant_start(x, zero_load, protocol.measured_strain(lat, step, x, zero_load),
-                             protocol.measured_strain(lat, previous, x, zero_load),
-                             protocol.measured_strain(lat, zero, zero_load, zero_load));
+    // Through the field's result two load values back, x_{k-2} (the zero-load state at k = 2,
+    // and where a checkpoint written before it was kept lacks it).
+    const KeptPositions& kept = state.earlier_load_results.at(step.field_index);
+    if (step.load_index >= 3 && kept.cols() > 0) {
+      const Eigen::Matrix3Xd earlier = kept.load();
+      const StepSpec& before = step_at(step.field_index, step.load_index - 2);
+      candidate = secant_start(x, earlier, protocol.measured_strain(lat, step, x, zero_load),
+                               protocol.measured_strain(lat, previous, x, zero_load),
+                               protocol.measured_strain(lat, before, earlier, zero_load));
+    } else {
+      const StepSpec& zero = step_at(step.field_index, 0);
+      candidate = secant_start(x, zero_load, protocol.measured_strain(lat, step, x, zero_load),
+                               protocol.measured_strain(lat, previous, x, zero_load),
+                               protocol.measured_strain(lat, zero, zero_load, zero_load));
+    }
     kind = step_start::kSecant;
   } else {
     // Load value 1: the previous field has just relaxed it (its slot) from its reference.
@@ -214,6 +232,16 @@ void hand_anchor_to_cache(ProtocolState& state, const lattice::Lattice& lat,
     cache.restore(lat, state.preconditioner_anchor);
   }
   state.preconditioner_anchor.reset();
+}
+
+// After a loaded step's prediction: its start `start`, the field's result at the strain before,
+// becomes the earlier point of the field's next strain step's secant
+// (ProtocolState::earlier_load_results); nothing where none was kept.
+void keep_load_start(const ProtocolRunner& runner, ProtocolState& state, std::size_t field,
+                     KeptPositions start) {
+  if (start.cols() == 0) return;
+  state.earlier_load_results.at(field) = std::move(start);
+  runner.park_kept_positions(state);
 }
 
 // The step's magnetization solves (since `before`) and its final solve; a step converges only
@@ -252,6 +280,9 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   LoadState load = protocol.load(lat, step, loaded ? reference_of_field() : lat.positions);
 
   SlotState& slot = state.slots[slot_of_field(step.field_index)];
+  // The start, x_{k-1} at this field (a shared copy where it is parked): keep_load_start.
+  KeptPositions load_start;
+  if (keeps_earlier_load_results() && step.load_index > 0) load_start = slot.positions;
   // With one slot, the field secant of the next field needs this step's start (the previous
   // field's result) after the step, when the slot holds this step's result.
   Eigen::Matrix3Xd start_to_keep;
@@ -268,6 +299,7 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   record.step = step;
   std::int64_t prediction_evaluations = 0;
   record.start = predict_start(step, state, prediction_evaluations);
+  keep_load_start(*this, state, step.field_index, std::move(load_start));
   // The secant has been made: its earlier point is not held while the step relaxes (this step's
   // start takes its place after the step).
   if (keeps_earlier_field_result()) state.earlier_field_result = KeptPositions();

@@ -103,6 +103,10 @@ struct ProtocolState {
   // second point of the field secant (load_step_start.hpp). Runs with a slot per field take it
   // from `references`.
   KeptPositions earlier_field_result;
+  // Strain runs with solver.load_step_start = "extrapolated": per field, the start of its latest
+  // loaded step, i.e. its result at the load value before the one its slot holds (0 columns:
+  // none yet), the earlier point of the next strain step's secant (load_step_start.hpp).
+  std::vector<KeptPositions> earlier_load_results;
   std::vector<StepRecord> records;  // of steps 0 .. next_step - 1
   // Where the multilevel preconditioner the next step may keep was built (solvers/
   // preconditioner_cache.hpp), shared with the runner's cache; null: none (the next step builds
@@ -128,6 +132,10 @@ class ProtocolRunner {
   // Whether the run's states keep ProtocolState::earlier_field_result (one slot, and
   // solver.field_step_start = "extrapolated"): after step k it holds step k - 1's result.
   bool keeps_earlier_field_result() const;
+  // Whether the run's states keep ProtocolState::earlier_load_results (a strain run with
+  // solver.load_step_start = "extrapolated"): after a loaded step at field f it holds that
+  // field's result at the load value before.
+  bool keeps_earlier_load_results() const;
 
   // Runs step state.next_step and advances the state. Throws std::logic_error past the end.
   const StepRecord& run_next_step(ProtocolState& state);

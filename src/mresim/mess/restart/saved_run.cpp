@@ -21,13 +21,18 @@ std::size_t slot_of(const StepSpec& step, std::size_t slots) {
   return slots > 1 ? step.field_index : 0;
 }
 
-// The final state's slots and references hold the results of these steps: their arrays move
-// over as they are (parked or in memory).
+// The final state's slots, references and earlier load results hold the results of these steps:
+// their arrays move over as they are (parked or in memory).
 void take_final_state(ProtocolState& final, const std::vector<StepSpec>& steps,
                       std::map<std::size_t, SavedPositions>& positions) {
   std::vector<std::optional<std::size_t>> last_in_slot(final.slots.size());
   std::vector<std::optional<std::size_t>> reference_step(final.references.size());
+  std::vector<std::optional<std::size_t>> earlier_load_step(final.earlier_load_results.size());
   for (std::size_t k = 0; k < final.next_step; ++k) {
+    if (steps[k].load_index > 0 && !final.earlier_load_results.empty()) {
+      earlier_load_step.at(steps[k].field_index) =
+          last_in_slot.at(slot_of(steps[k], final.slots.size()));
+    }
     last_in_slot.at(slot_of(steps[k], final.slots.size())) = k;
     if (steps[k].load_index == 0 && !final.references.empty()) {
       reference_step.at(steps[k].field_index) = k;
@@ -43,6 +48,12 @@ void take_final_state(ProtocolState& final, const std::vector<StepSpec>& steps,
     if (reference_step[f] && final.references[f].cols() > 0) {
       positions.insert_or_assign(*reference_step[f],
                                  SavedPositions(std::move(final.references[f])));
+    }
+  }
+  for (std::size_t f = 0; f < earlier_load_step.size(); ++f) {
+    if (earlier_load_step[f] && final.earlier_load_results[f].cols() > 0) {
+      positions.insert_or_assign(*earlier_load_step[f],
+                                 SavedPositions(std::move(final.earlier_load_results[f])));
     }
   }
   // One slot: the result of the step before the last (ProtocolState::earlier_field_result).
@@ -106,16 +117,23 @@ struct StateSources {
   std::vector<std::optional<std::size_t>> slots;
   std::vector<std::optional<std::size_t>> references;
   std::optional<std::size_t> earlier_field_result;
+  std::vector<std::optional<std::size_t>> earlier_load_results;
 };
 
 StateSources sources_after(const SavedRun& saved, const ProtocolRunner& runner,
                            const ProtocolState& initial, std::size_t count) {
-  StateSources sources{std::vector<std::optional<std::size_t>>(initial.slots.size()),
-                       std::vector<std::optional<std::size_t>>(initial.references.size()),
-                       std::nullopt};
+  StateSources sources{
+      std::vector<std::optional<std::size_t>>(initial.slots.size()),
+      std::vector<std::optional<std::size_t>>(initial.references.size()), std::nullopt,
+      std::vector<std::optional<std::size_t>>(initial.earlier_load_results.size())};
   if (runner.keeps_earlier_field_result() && count >= 2) sources.earlier_field_result = count - 2;
   for (std::size_t k = 0; k < count; ++k) {
     const StepSpec& step = saved.steps[k];
+    // A loaded step keeps its start, the slot's result before it (ProtocolRunner).
+    if (step.load_index > 0 && !initial.earlier_load_results.empty()) {
+      sources.earlier_load_results.at(step.field_index) =
+          sources.slots.at(slot_of(step, initial.slots.size()));
+    }
     sources.slots.at(slot_of(step, initial.slots.size())) = k;
     if (step.load_index == 0 && !initial.references.empty()) {
       sources.references.at(step.field_index) = k;
@@ -134,7 +152,7 @@ bool restorable(const SavedRun& saved, const ProtocolRunner& runner, const Proto
   if (count > saved.records.size() || count > saved.steps.size()) return false;
   const StateSources sources = sources_after(saved, runner, initial, count);
   return kept(saved, sources.slots) && kept(saved, sources.references) &&
-         kept(saved, {sources.earlier_field_result});
+         kept(saved, {sources.earlier_field_result}) && kept(saved, sources.earlier_load_results);
 }
 
 // Whether a run continued from the state after `count` steps builds or keeps the multilevel
@@ -171,6 +189,11 @@ std::optional<ProtocolState> state_after(const SavedRun& saved, const ProtocolRu
   for (std::size_t f = 0; f < state.references.size(); ++f) {
     if (!sources.references[f]) continue;
     state.references[f] = saved.positions.at(*sources.references[f]).load();
+    runner.park_kept_positions(state);
+  }
+  for (std::size_t f = 0; f < state.earlier_load_results.size(); ++f) {
+    if (!sources.earlier_load_results[f]) continue;
+    state.earlier_load_results[f] = saved.positions.at(*sources.earlier_load_results[f]).load();
     runner.park_kept_positions(state);
   }
   if (sources.earlier_field_result) {

@@ -361,15 +361,21 @@ void describe_mess(const MessSpec& s, app::InfoReport& r) {
                 s.output.checkpoint_every == 0 ? "no checkpoints" : "");
   // final_state.h5: the positions of every slot (one per field with a load) and the zero-load
   // references, float64 (restart/saved_run.hpp); with one slot and predicted field steps also
-  // the result before the last (ProtocolState::earlier_field_result); where the multilevel
+  // the result before the last (ProtocolState::earlier_field_result), with a slot per field and
+  // predicted strain steps each field's result at the load value before its slot's
+  // (ProtocolState::earlier_load_results); where the multilevel
   // preconditioner is kept between steps, the positions it was built at (its anchor).
   const bool earlier_result = s.solver.field_step_start == FieldStepStart::extrapolated;
   const bool anchor = s.solver.method == SolverMethod::minimiser &&
                       s.solver.preconditioner_reuse > 0.0 &&
                       s.geometry.node_count() >= mess::kMultilevelMinimumNodes;
-  const double slots = (s.load_step_count() > 1 ? 2.0 * static_cast<double>(s.field.values.size())
-                                                : (earlier_result ? 2.0 : 1.0)) +
-                       (anchor ? 1.0 : 0.0);
+  const bool earlier_loads = s.solver.load_step_start == LoadStepStart::extrapolated &&
+                             s.load_step_count() > 1 && s.protocol->loads_from_zero_load_state();
+  const double per_field = earlier_loads ? 3.0 : 2.0;
+  const double slots =
+      (s.load_step_count() > 1 ? per_field * static_cast<double>(s.field.values.size())
+                               : (earlier_result ? 2.0 : 1.0)) +
+      (anchor ? 1.0 : 0.0);
   r.add_text("output", "keep_final_state", s.output.keep_final_state ? "on" : "off",
              s.output.keep_final_state
                  ? fmt::format("final_state.h5 of {:.3g} MB, for mresim extend and rerun",
