@@ -143,13 +143,11 @@ const StepSpec& ProtocolRunner::step_at(std::size_t field_index, std::size_t loa
 }
 
 bool ProtocolRunner::keeps_earlier_load_results() const {
-  return spec_.solver.load_step_start == mc::LoadStepStart::extrapolated &&
-         spec_.load_step_count() > 1 && spec_.protocol->loads_from_zero_load_state();
+  return spec_.keeps_earlier_load_results();
 }
 
 bool ProtocolRunner::keeps_earlier_field_result() const {
-  return spec_.solver.field_step_start == mc::FieldStepStart::extrapolated &&
-         spec_.load_step_count() <= 1;
+  return spec_.keeps_earlier_field_result();
 }
 
 Eigen::Matrix3Xd ProtocolRunner::field_secant_candidate(const StepSpec& step,

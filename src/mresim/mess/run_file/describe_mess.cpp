@@ -365,13 +365,11 @@ void describe_mess(const MessSpec& s, app::InfoReport& r) {
   // predicted strain steps each field's result at the load value before its slot's
   // (ProtocolState::earlier_load_results); where the multilevel
   // preconditioner is kept between steps, the positions it was built at (its anchor).
-  const bool earlier_result = s.solver.field_step_start == FieldStepStart::extrapolated;
+  const bool earlier_result = s.keeps_earlier_field_result();
   const bool anchor = s.solver.method == SolverMethod::minimiser &&
                       s.solver.preconditioner_reuse > 0.0 &&
                       s.geometry.node_count() >= mess::kMultilevelMinimumNodes;
-  const bool earlier_loads = s.solver.load_step_start == LoadStepStart::extrapolated &&
-                             s.load_step_count() > 1 && s.protocol->loads_from_zero_load_state();
-  const double per_field = earlier_loads ? 3.0 : 2.0;
+  const double per_field = s.keeps_earlier_load_results() ? 3.0 : 2.0;
   const double slots =
       (s.load_step_count() > 1 ? per_field * static_cast<double>(s.field.values.size())
                                : (earlier_result ? 2.0 : 1.0)) +

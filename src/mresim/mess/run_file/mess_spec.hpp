@@ -309,6 +309,14 @@ struct MessSpec {
   std::size_t load_step_count() const;
   // Relaxations the run performs: fields x load values.
   std::size_t relaxation_count() const;
+  // Whether the run keeps, per field, the result at the load value before the slot's, for the
+  // next load step's secant (solver.load_step_start = "extrapolated", more than one load value,
+  // a protocol that loads from the zero-load state; ProtocolState::earlier_load_results).
+  bool keeps_earlier_load_results() const;
+  // Whether the run keeps the field result before the last, for the next field step's secant
+  // (solver.field_step_start = "extrapolated" without load values;
+  // ProtocolState::earlier_field_result).
+  bool keeps_earlier_field_result() const;
 };
 
 // Reads every table of the 3D schema except [run] ([model], [particles], [box], [field],

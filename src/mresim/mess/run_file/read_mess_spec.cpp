@@ -828,6 +828,15 @@ std::size_t MessSpec::load_step_count() const { return protocol->load_values().s
 
 std::size_t MessSpec::relaxation_count() const { return field.values.size() * load_step_count(); }
 
+bool MessSpec::keeps_earlier_load_results() const {
+  return solver.load_step_start == LoadStepStart::extrapolated && load_step_count() > 1 &&
+         protocol->loads_from_zero_load_state();
+}
+
+bool MessSpec::keeps_earlier_field_result() const {
+  return solver.field_step_start == FieldStepStart::extrapolated && load_step_count() <= 1;
+}
+
 MessSpec read_mess_spec(const TableReader& root, std::string_view run_type) {
   // std::invalid_argument for a name that is not a registered protocol (a programming error).
   const mess_protocol::ProtocolType& type = mess_protocol::find_protocol(run_type);
