@@ -194,18 +194,13 @@ std::string ProtocolRunner::predict_start(const StepSpec& step, const ProtocolSt
     // Through the field's result two load values back, x_{k-2} (the zero-load state at k = 2,
     // and where a checkpoint written before it was kept lacks it).
     const KeptPositions& kept = state.earlier_load_results.at(step.field_index);
-    if (step.load_index >= 3 && kept.cols() > 0) {
-      const Eigen::Matrix3Xd earlier = kept.load();
-      const StepSpec& before = step_at(step.field_index, step.load_index - 2);
-      candidate = secant_start(x, earlier, protocol.measured_strain(lat, step, x, zero_load),
-                               protocol.measured_strain(lat, previous, x, zero_load),
-                               protocol.measured_strain(lat, before, earlier, zero_load));
-    } else {
-      const StepSpec& zero = step_at(step.field_index, 0);
-      candidate = secant_start(x, zero_load, protocol.measured_strain(lat, step, x, zero_load),
-                               protocol.measured_strain(lat, previous, x, zero_load),
-                               protocol.measured_strain(lat, zero, zero_load, zero_load));
-    }
+    const bool local = step.load_index >= 3 && kept.cols() > 0;
+    const Eigen::Matrix3Xd loaded = local ? kept.load() : Eigen::Matrix3Xd();
+    const Eigen::Matrix3Xd& earlier = local ? loaded : zero_load;
+    const StepSpec& before = step_at(step.field_index, local ? step.load_index - 2 : 0);
+    candidate = secant_start(x, earlier, protocol.measured_strain(lat, step, x, zero_load),
+                             protocol.measured_strain(lat, previous, x, zero_load),
+                             protocol.measured_strain(lat, before, earlier, zero_load));
     kind = step_start::kSecant;
   } else {
     // Load value 1: the previous field has just relaxed it (its slot) from its reference.
