@@ -1,16 +1,17 @@
 // Where a strain run's steps start (solver.load_step_start, protocols/load_step_start.hpp): the
 // scaled-down Fig. 4.14 shear run (Phi = 3 %, seed profile) through strains 0 ... 0.1 rad at
-// three fields, once from the previous strain's state as it is ("previous", the original's
-// start) and once from the predicted state ("extrapolated", the default), in one run. Prints per
-// start the iterations, evaluations and CPU time of the strained steps, the ratios, and how far
-// apart the two runs' results are.
+// three fields, from the previous strain's state as it is ("previous", the original's start),
+// from the strain secant ("secant", the prediction without the previous fields' corrections)
+// and from the corrected prediction ("extrapolated", the default), in one run. Prints per start
+// the iterations, evaluations and CPU time of the strained steps, the ratios against the
+// default, and how far apart the runs' results are.
 //
 //   ./build/strain_start_bench [--order N] [--steps K] [--repeats R]
 //
 // --order: the discretization order n_d (default 5: 52,200 nodes, where the default minimiser
 // uses the multilevel preconditioner); --steps: strain values after 0 (default 5); --repeats:
-// runs of each start, alternating, the fastest CPU time kept (default 1). One thread per run
-// unless OMP_NUM_THREADS says otherwise.
+// runs of each start, in turn, the fastest CPU time kept (default 1). One thread per run unless
+// OMP_NUM_THREADS says otherwise.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -38,6 +39,30 @@ Run run(const std::string& start, int order, int steps) {
       start, [](const mp::StepRecord& record) { return record.step.load_index > 0; });
 }
 
+// The largest differences of two runs' steps, and the starts the second one took.
+void print_differences(const char* name, const Run& reference, const Run& run) {
+  double centres = 0.0;
+  double magnetization = 0.0;
+  double energy = 0.0;
+  std::vector<std::string> starts;
+  for (std::size_t i = 0; i < reference.records.size(); ++i) {
+    const mp::StepRecord& a = reference.records[i];
+    const mp::StepRecord& b = run.records[i];
+    centres = std::max(centres, (a.centres - b.centres).cwiseAbs().maxCoeff());
+    magnetization =
+        std::max(magnetization, (a.magnetization - b.magnetization).cwiseAbs().maxCoeff());
+    energy = std::max(
+        energy, std::abs(a.energies.total() - b.energies.total()) / std::abs(a.energies.total()));
+    if (std::find(starts.begin(), starts.end(), b.start) == starts.end()) starts.push_back(b.start);
+  }
+  std::printf(
+      "  %-12s against previous: centres %.2e m, M %.2e A/m, total energy %.2e relative; "
+      "starts:",
+      name, centres, magnetization, energy);
+  for (const std::string& s : starts) std::printf(" %s", s.c_str());
+  std::printf("\n");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -49,46 +74,29 @@ int main(int argc, char** argv) {
   double load[3] = {};
   if (getloadavg(load, 3) > 0) std::printf("load average at start: %.2f\n", load[0]);
 
-  Run previous;
-  Run extrapolated;
+  const std::vector<std::string> names = {"previous", "secant", "extrapolated"};
+  std::vector<Run> runs(names.size());
   for (int k = 0; k < repeats; ++k) {
-    Run a = run("previous", order, steps);
-    Run b = run("extrapolated", order, steps);
-    if (a.cpu < previous.cpu) previous = std::move(a);
-    if (b.cpu < extrapolated.cpu) extrapolated = std::move(b);
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      Run r = run(names[i], order, steps);
+      if (r.cpu < runs[i].cpu) runs[i] = std::move(r);
+    }
   }
   std::printf(
       "Fig. 4.14 shear (small), n_d = %d: %lld nodes, 3 fields x %d strain steps to 0.1 rad\n",
-      order, static_cast<long long>(previous.nodes), steps);
-  for (const auto& [name, r] :
-       {std::pair<const char*, const Run&>{"previous", previous}, {"extrapolated", extrapolated}}) {
-    std::printf("  %-12s strained steps: %6lld iterations, %6lld evaluations, CPU %8.2f s\n", name,
-                static_cast<long long>(r.iterations), static_cast<long long>(r.evaluations), r.cpu);
+      order, static_cast<long long>(runs[0].nodes), steps);
+  const Run& best = runs.back();
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const Run& r = runs[i];
+    std::printf(
+        "  %-12s strained steps: %6lld iterations, %6lld evaluations, CPU %8.2f s; against "
+        "extrapolated: iterations %.2fx, CPU %.2fx\n",
+        names[i].c_str(), static_cast<long long>(r.iterations),
+        static_cast<long long>(r.evaluations), r.cpu,
+        static_cast<double>(r.iterations) / static_cast<double>(best.iterations), r.cpu / best.cpu);
   }
-  std::printf(
-      "  previous / extrapolated: iterations %.2fx, evaluations %.2fx, CPU %.2fx\n",
-      static_cast<double>(previous.iterations) / static_cast<double>(extrapolated.iterations),
-      static_cast<double>(previous.evaluations) / static_cast<double>(extrapolated.evaluations),
-      previous.cpu / extrapolated.cpu);
-
-  double centres = 0.0;
-  double magnetization = 0.0;
-  double energy = 0.0;
-  std::vector<std::string> starts;
-  for (std::size_t i = 0; i < previous.records.size(); ++i) {
-    const mp::StepRecord& a = previous.records[i];
-    const mp::StepRecord& b = extrapolated.records[i];
-    centres = std::max(centres, (a.centres - b.centres).cwiseAbs().maxCoeff());
-    magnetization =
-        std::max(magnetization, (a.magnetization - b.magnetization).cwiseAbs().maxCoeff());
-    energy = std::max(
-        energy, std::abs(a.energies.total() - b.energies.total()) / std::abs(a.energies.total()));
-    if (std::find(starts.begin(), starts.end(), b.start) == starts.end()) starts.push_back(b.start);
+  for (std::size_t i = 1; i < names.size(); ++i) {
+    print_differences(names[i].c_str(), runs[0], runs[i]);
   }
-  std::printf("  largest differences: centres %.2e m, M %.2e A/m, total energy %.2e relative\n",
-              centres, magnetization, energy);
-  std::printf("  extrapolated run's starts:");
-  for (const std::string& s : starts) std::printf(" %s", s.c_str());
-  std::printf("\n");
   return 0;
 }

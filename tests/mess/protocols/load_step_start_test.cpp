@@ -129,6 +129,50 @@ TEST(LoadStepStart, ALowerCandidateIsTakenWithItsHeldCoordinatesFromTheConstrain
                std::invalid_argument);
 }
 
+TEST(LoadStepStart, TheLowestOfSeveralCandidatesIsTakenWithItsMagnetization) {
+  mess::MessSystem system = guarded_system();
+  const Eigen::Matrix3Xd rest = system.positions();
+  const double l_e = system.length_scale();
+  const Eigen::Matrix3Xd start = rest + 0.2 * l_e * Eigen::Matrix3Xd::Random(3, rest.cols());
+  system.set_positions(start);
+  const Eigen::Matrix3Xd own = system.positions();  // with the held coordinates put on
+  const Eigen::Matrix3Xd history = system.magnetizations();
+  // What the system holds after evaluating the rest lattice from the same M history.
+  mess::MessSystem reference = system;
+  reference.set_positions(rest);
+  reference.set_magnetizations(history);
+  (void)reference.evaluate(nullptr);
+
+  // The rest lattice (lowest) between two lesser strains of it: taken, though not the last.
+  std::vector<Eigen::Matrix3Xd> candidates = {
+      rest + 0.05 * l_e * Eigen::Matrix3Xd::Random(3, rest.cols()), rest,
+      rest + 0.02 * l_e * Eigen::Matrix3Xd::Random(3, rest.cols())};
+  const std::vector<Eigen::Matrix3Xd> offered = candidates;
+  ASSERT_EQ(take_lowest(system, candidates), 1);
+  EXPECT_EQ(system.positions(), reference.positions());
+  EXPECT_EQ(system.magnetizations(), reference.magnetizations());
+  // The others are left as offered (their held coordinates from the constraints, which they
+  // already had); the taken one's entry holds the system's own start.
+  EXPECT_EQ(candidates[2].cols(), offered[2].cols());
+  EXPECT_EQ(candidates[1], own);
+
+  // Equal potentials: the earlier candidate.
+  system.set_positions(start);
+  system.set_magnetizations(history);
+  std::vector<Eigen::Matrix3Xd> twins = {rest, rest};
+  EXPECT_EQ(take_lowest(system, twins), 0);
+
+  // None below the system's own: nothing changes, bit for bit.
+  system.set_positions(rest);
+  system.set_magnetizations(history);
+  (void)system.evaluate(nullptr);
+  const Eigen::Matrix3Xd magnetization = system.magnetizations();
+  std::vector<Eigen::Matrix3Xd> higher = {offered[0], offered[2]};
+  EXPECT_EQ(take_lowest(system, higher), -1);
+  EXPECT_EQ(system.positions(), rest);
+  EXPECT_EQ(system.magnetizations(), magnetization);
+}
+
 // The small pair (support/small_runs.hpp) sheared at two fields through four strains.
 std::string small_shear(const std::string& start) {
   return std::string("[run]\ntype = \"mess_strain\"\n") + testing::kSmallModel +
@@ -147,12 +191,13 @@ TEST(LoadStepStart, PredictedStartsReachTheOriginalsStatesInFewerIterations) {
 
   // Step n = k F + f (F = 2): the first step from the lattice; the zero strains and the first
   // strain at the first field from the previous state; the first strain at the second field
-  // from the first field's response; later strains on the secant.
+  // from the first field's response; later strains on the secant, at the second field
+  // corrected by the first field's miss.
   const std::vector<std::string> expected_start = {
-      step_start::kInitialLattice, step_start::kPrevious, step_start::kPrevious,
-      step_start::kNeighbourField, step_start::kSecant,   step_start::kSecant,
-      step_start::kSecant,         step_start::kSecant,   step_start::kSecant,
-      step_start::kSecant};
+      step_start::kInitialLattice, step_start::kPrevious,        step_start::kPrevious,
+      step_start::kNeighbourField, step_start::kSecant,          step_start::kCorrectedSecant,
+      step_start::kSecant,         step_start::kCorrectedSecant, step_start::kSecant,
+      step_start::kCorrectedSecant};
   std::int64_t iterations_previous = 0;
   std::int64_t iterations_predicted = 0;
   for (std::size_t i = 0; i < previous.size(); ++i) {
@@ -215,6 +260,102 @@ TEST(LoadStepStart, EachLoadedStepKeepsItsStartForTheFieldsNextSecant) {
   const ProtocolRunner original(spec_of(small_shear("previous")));
   EXPECT_FALSE(original.keeps_earlier_load_results());
   EXPECT_TRUE(original.initial_state().earlier_load_results.empty());
+}
+
+// The small pair sheared at three fields through four strains (15 steps, step n = 3 k + f).
+std::string three_field_shear(const std::string& start) {
+  return std::string("[run]\ntype = \"mess_strain\"\n") + testing::kSmallModel +
+         "\n[field]\nmagnitudes = [0.0, 0.05, 0.1]\n"
+         "\n[strain]\nkind = \"shear\"\nnormal = \"z\"\ndirection = \"x\"\n"
+         "max = 0.02\nsteps = 4\n" +
+         (start.empty() ? "" : "\n[solver]\nload_step_start = \"" + start + "\"\n");
+}
+
+// From the second strain on, a later field's step is offered its secant corrected by the
+// previous field's miss (and, from the third field, by that miss extrapolated in the field):
+// the lowest start is taken, and the steps reach the original's states.
+TEST(LoadStepStart, LaterFieldsStartFromTheSecantCorrectedByThePreviousFieldsMiss) {
+  const std::vector<StepRecord> previous = testing::records_of_run(three_field_shear("previous"));
+  const std::vector<StepRecord> secant = testing::records_of_run(three_field_shear("secant"));
+  const std::vector<StepRecord> predicted = testing::records_of_run(three_field_shear(""));
+  ASSERT_EQ(previous.size(), 15U);
+  ASSERT_EQ(predicted.size(), previous.size());
+  ASSERT_EQ(secant.size(), previous.size());
+  std::int64_t iterations_secant = 0;
+  std::int64_t iterations_predicted = 0;
+  for (std::size_t i = 0; i < previous.size(); ++i) {
+    const StepSpec& step = predicted[i].step;
+    const double energy_scale = std::abs(previous[i].energies.total());
+    testing::expect_same_minimum(previous[i], predicted[i], i, energy_scale);
+    testing::expect_same_minimum(previous[i], secant[i], i, energy_scale);
+    if (step.load_index == 0) continue;
+    // "secant": the prediction without the corrections.
+    const std::string first_strain =
+        step.field_index == 0 ? step_start::kPrevious : step_start::kNeighbourField;
+    EXPECT_EQ(secant[i].start, step.load_index == 1 ? first_strain : step_start::kSecant)
+        << "step " << i;
+    if (step.load_index < 2) continue;
+    // The first field has no field before it at this strain: its plain secant.
+    EXPECT_EQ(predicted[i].start,
+              step.field_index == 0 ? step_start::kSecant : step_start::kCorrectedSecant)
+        << "step " << i;
+    if (step.field_index > 0) {
+      iterations_secant += secant[i].iterations;
+      iterations_predicted += predicted[i].iterations;
+    }
+  }
+  EXPECT_LT(iterations_predicted, iterations_secant);
+}
+
+// A step keeps its miss, x_k(f) - S_k(f), only for the next field's step at the same strain,
+// with the miss of the step before it; what it keeps is what secant_miss_of recomputes from the
+// steps' results (a rebuilt state, restart/saved_run.hpp), bit for bit.
+TEST(LoadStepStart, EachKeptMissIsTheStepsResultMinusItsSecant) {
+  const mess_config::MessSpec spec = spec_of(three_field_shear(""));
+  ProtocolRunner runner(spec);
+  ProtocolState state = runner.initial_state();
+  std::vector<Eigen::Matrix3Xd> results;
+  Eigen::Matrix3Xd last_miss;
+  std::size_t kept = 0;
+  while (state.next_step < runner.steps().size()) {
+    const std::size_t i = state.next_step;
+    runner.run_next_step(state);
+    results.push_back(state.slots[runner.steps()[i].field_index].positions.load());
+    if (!runner.next_step_takes_miss(i)) {
+      EXPECT_EQ(state.secant_miss.cols(), 0) << "step " << i;
+      EXPECT_EQ(state.earlier_secant_miss.cols(), 0) << "step " << i;
+      last_miss.resize(3, 0);
+      continue;
+    }
+    std::vector<Eigen::Matrix3Xd> sources;
+    for (const std::size_t k : runner.secant_miss_sources(i)) sources.push_back(results.at(k));
+    const Eigen::Matrix3Xd miss = runner.secant_miss_of(i, sources);
+    EXPECT_TRUE(state.secant_miss.load() == miss) << "step " << i;
+    EXPECT_GT(miss.cwiseAbs().maxCoeff(), 0.0) << "step " << i;
+    ASSERT_EQ(state.earlier_secant_miss.cols(), last_miss.cols()) << "step " << i;
+    EXPECT_TRUE(state.earlier_secant_miss.load() == last_miss) << "step " << i;
+    last_miss = miss;
+    ++kept;
+  }
+  // Strains 2 to 4 at the first two fields.
+  EXPECT_EQ(kept, 6U);
+}
+
+TEST(LoadStepStart, ResumedWithTheMissesInTheCheckpointEqualsTheUninterruptedRun) {
+  const std::string toml = three_field_shear("");
+  const mess_config::MessSpec spec = spec_of(toml);
+  const std::vector<StepRecord> full = testing::records_of_run(toml);
+  // After step 6 (the first field at the second strain) the state holds its miss; after step 7
+  // (the second field) that one and step 7's, which step 8 extrapolates in the field.
+  for (const std::size_t done : {7U, 8U}) {
+    const mresim::testing::TempDir dir;
+    ProtocolRunner second(spec);
+    ProtocolState resumed = testing::resumed_after(toml, done, dir / "checkpoint.h5", second);
+    EXPECT_GT(resumed.secant_miss.cols(), 0) << done;
+    EXPECT_EQ(resumed.earlier_secant_miss.cols() > 0, done == 8) << done;
+    second.run(resumed, nullptr);
+    testing::expect_same_records(resumed.records, full);
+  }
 }
 
 }  // namespace

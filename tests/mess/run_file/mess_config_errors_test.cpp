@@ -234,7 +234,8 @@ INSTANTIATE_TEST_SUITE_P(
                  "\"mess_strain\" (the runs whose load steps start from the previous load "
                  "value)"},
         BadInput{"UnknownLoadStepStart", kStrain + "[solver]\nload_step_start = \"predicted\"\n",
-                 "solver.load_step_start = \"predicted\": must be one of extrapolated, previous"},
+                 "solver.load_step_start = \"predicted\": must be one of extrapolated, secant, "
+                 "previous"},
         BadInput{"NegativeMagnetizationTolerance",
                  kValid + "[solver.magnetization]\natol = -1e-3\n",
                  "solver.magnetization.atol = -0.001: must be >= 1e-15 (Ms)"},

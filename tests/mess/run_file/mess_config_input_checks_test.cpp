@@ -237,7 +237,16 @@ TEST(MessMemory, EstimateIsFixedPlusPerNodePlusDenseMagnetization) {
   ASSERT_EQ(sheared.load_step_count(), 3U);
   EXPECT_EQ(mc::estimated_memory_bytes(sheared),
             mc::kFixedBytes + 3700 * mc::kBytesPerNode + 32 * 36);
-  EXPECT_EQ(mc::scratch_bytes_per_node(sheared), 3 * mc::kPerFieldScratchBytesPerNode);
+  // With the default "extrapolated" starts also each field's result at the strain before, the
+  // step's secant and two fields' misses of it.
+  ASSERT_TRUE(sheared.keeps_earlier_load_results());
+  EXPECT_EQ(mc::scratch_bytes_per_node(sheared),
+            3 * (mc::kPerFieldScratchBytesPerNode + mc::kEarlierLoadScratchBytesPerNode) +
+                mc::kSecantScratchBytesPerNode);
+  const mc::MessSpec sheared_from_previous =
+      read_spec(strain + "\n[solver]\nload_step_start = \"previous\"\n");
+  EXPECT_EQ(mc::scratch_bytes_per_node(sheared_from_previous),
+            3 * mc::kPerFieldScratchBytesPerNode);
   EXPECT_EQ(mc::scratch_bytes_per_node(spec), 0);
   EXPECT_NO_THROW(mc::check_memory(spec, {std::nullopt, "unknown"}));
   try {

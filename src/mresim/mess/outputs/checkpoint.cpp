@@ -28,6 +28,9 @@ constexpr std::int64_t kOldestReadable = 2;
 
 // ProtocolState::earlier_field_result, where the state holds one.
 constexpr const char* kEarlierFieldResult = "/earlier_field_result";
+// ProtocolState::secant_miss and earlier_secant_miss, where the state holds them.
+constexpr const char* kSecantMiss = "/secant_miss";
+constexpr const char* kEarlierSecantMiss = "/earlier_secant_miss";
 // ProtocolState::preconditioner_anchor, where the state holds one: its positions (single
 // precision values, stored exactly as doubles); its key is the root attribute kAnchorKey
 // (version 2: an attribute "key" of this dataset).
@@ -55,6 +58,8 @@ void for_each_kept_array(State& state, Visit&& visit) {
   for (std::size_t i = 0; i < state.earlier_load_results.size(); ++i) {
     visit(fmt::format("/earlier_load_results/{}", i), state.earlier_load_results[i]);
   }
+  visit(std::string(kSecantMiss), state.secant_miss);
+  visit(std::string(kEarlierSecantMiss), state.earlier_secant_miss);
 }
 
 void write_optional(io::Hdf5File& file, const std::string& path, const Eigen::Matrix3Xd& m,

@@ -62,20 +62,48 @@ Eigen::Matrix3Xd neighbour_field_start(const Eigen::Matrix3Xd& zero_load,
   return zero_load + (neighbour_loaded - neighbour_zero_load);
 }
 
-bool take_if_not_higher(mess::MessSystem& system, Eigen::Matrix3Xd& candidate) {
-  check_same_size("take_if_not_higher", system.positions(), candidate, "the system's positions",
-                  "candidate");
+int take_lowest(mess::MessSystem& system, std::vector<Eigen::Matrix3Xd>& candidates) {
+  for (const Eigen::Matrix3Xd& candidate : candidates) {
+    check_same_size("take_lowest", system.positions(), candidate, "the system's positions",
+                    "a candidate");
+  }
   const Eigen::Matrix3Xd magnetization = system.magnetizations();
   const bool history = system.has_magnetization_history();
-  const double current = system.evaluate(nullptr).potential;
-  if (history) system.set_magnetizations(magnetization);
-  std::swap(system.mutable_positions(), candidate);
-  system.apply_constraints();
-  const double predicted = system.evaluate(nullptr).potential;
-  if (std::isfinite(predicted) && predicted <= current) return true;
-  std::swap(system.mutable_positions(), candidate);
-  if (history) system.set_magnetizations(magnetization);
-  return false;
+  double lowest = system.evaluate(nullptr).potential;
+  int best = -1;
+  Eigen::Matrix3Xd best_magnetization;
+  const int last = static_cast<int>(candidates.size()) - 1;
+  for (int i = 0; i <= last; ++i) {
+    if (history) system.set_magnetizations(magnetization);
+    std::swap(system.mutable_positions(), candidates[i]);
+    system.apply_constraints();
+    const double potential = system.evaluate(nullptr).potential;
+    // Not above the system's own potential; strictly below an earlier candidate's.
+    const bool lower =
+        std::isfinite(potential) && (best < 0 ? potential <= lowest : potential < lowest);
+    if (lower) {
+      best = i;
+      lowest = potential;
+      if (i == last) return best;  // the system holds it, with M solved there
+      best_magnetization = system.magnetizations();
+    }
+    std::swap(system.mutable_positions(), candidates[i]);
+  }
+  if (best < 0) {
+    if (history) system.set_magnetizations(magnetization);
+    return -1;
+  }
+  std::swap(system.mutable_positions(), candidates[best]);
+  system.set_magnetizations(best_magnetization);
+  return best;
+}
+
+bool take_if_not_higher(mess::MessSystem& system, Eigen::Matrix3Xd& candidate) {
+  std::vector<Eigen::Matrix3Xd> one;
+  one.push_back(std::move(candidate));
+  const int taken = take_lowest(system, one);
+  candidate = std::move(one.front());
+  return taken == 0;
 }
 
 }  // namespace mresim::mess_protocol

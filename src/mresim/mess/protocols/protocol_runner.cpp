@@ -80,6 +80,8 @@ void ProtocolRunner::park_kept_positions(ProtocolState& state) const {
   for (SlotState& slot : state.slots) slot.positions.park(state.spill);
   for (KeptPositions& reference : state.references) reference.park(state.spill);
   for (KeptPositions& earlier : state.earlier_load_results) earlier.park(state.spill);
+  state.secant_miss.park(state.spill);
+  state.earlier_secant_miss.park(state.spill);
 }
 
 const SlotState* ProtocolRunner::start_state(const StepSpec& step,
@@ -146,6 +148,11 @@ bool ProtocolRunner::keeps_earlier_load_results() const {
   return spec_.keeps_earlier_load_results();
 }
 
+bool ProtocolRunner::corrects_load_starts() const {
+  return keeps_earlier_load_results() &&
+         spec_.solver.load_step_start == mc::LoadStepStart::extrapolated;
+}
+
 bool ProtocolRunner::keeps_earlier_field_result() const {
   return spec_.keeps_earlier_field_result();
 }
@@ -165,8 +172,83 @@ Eigen::Matrix3Xd ProtocolRunner::field_secant_candidate(const StepSpec& step,
   return field_secant_start(system_.positions(), earlier.load(), step.field, b_previous, b_earlier);
 }
 
+Eigen::Matrix3Xd ProtocolRunner::strain_secant(const StepSpec& step,
+                                               const Eigen::Matrix3Xd& previous,
+                                               const Eigen::Matrix3Xd& earlier,
+                                               const Eigen::Matrix3Xd& zero_load) const {
+  const Protocol& protocol = *spec_.protocol;
+  const lattice::Lattice& lat = system_.lattice();
+  const bool local = earlier.cols() > 0;
+  const Eigen::Matrix3Xd& through = local ? earlier : zero_load;
+  const StepSpec& previous_step = step_at(step.field_index, step.load_index - 1);
+  const StepSpec& before = step_at(step.field_index, local ? step.load_index - 2 : 0);
+  return secant_start(previous, through, protocol.measured_strain(lat, step, previous, zero_load),
+                      protocol.measured_strain(lat, previous_step, previous, zero_load),
+                      protocol.measured_strain(lat, before, through, zero_load));
+}
+
+std::vector<Eigen::Matrix3Xd> ProtocolRunner::corrected_secants(
+    const StepSpec& step, const ProtocolState& state, const Eigen::Matrix3Xd& secant) const {
+  std::vector<Eigen::Matrix3Xd> candidates;
+  const auto is_field_before = [&](std::size_t back, std::size_t fields_before) {
+    if (state.records.size() < back || step.field_index < fields_before) return false;
+    const StepSpec& earlier = state.records[state.records.size() - back].step;
+    return earlier.field_index == step.field_index - fields_before &&
+           earlier.load_index == step.load_index;
+  };
+  if (state.secant_miss.cols() == 0 || !is_field_before(1, 1)) return candidates;
+  // The previous field's miss, m_{f-1}.
+  const Eigen::Matrix3Xd miss = state.secant_miss.load();
+  candidates.push_back(secant + miss);
+  if (state.earlier_secant_miss.cols() == 0 || !is_field_before(2, 2)) return candidates;
+  // m_{f-1} + r (m_{f-1} - m_{f-2}): the miss extrapolated in the field, as the field secant
+  // extrapolates the states.
+  const Eigen::Vector3d& b_previous = state.records.back().step.field;
+  const Eigen::Vector3d& b_earlier = state.records[state.records.size() - 2].step.field;
+  if (b_previous == b_earlier) return candidates;
+  candidates.push_back(secant + field_secant_start(miss, state.earlier_secant_miss.load(),
+                                                   step.field, b_previous, b_earlier));
+  return candidates;
+}
+
+bool ProtocolRunner::next_step_takes_miss(std::size_t index) const {
+  if (!corrects_load_starts() || index + 1 >= steps_.size()) return false;
+  const StepSpec& step = steps_[index];
+  const StepSpec& next = steps_[index + 1];
+  return step.load_index >= 2 && next.load_index == step.load_index &&
+         next.field_index == step.field_index + 1;
+}
+
+std::vector<std::size_t> ProtocolRunner::secant_miss_sources(std::size_t index) const {
+  if (!next_step_takes_miss(index)) return {};
+  const StepSpec& step = steps_[index];
+  std::vector<std::size_t> sources = {index, step_at(step.field_index, step.load_index - 1).index};
+  if (step.load_index >= 3) {
+    sources.push_back(step_at(step.field_index, step.load_index - 2).index);
+  }
+  sources.push_back(step_at(step.field_index, 0).index);
+  return sources;
+}
+
+Eigen::Matrix3Xd ProtocolRunner::secant_miss_of(
+    std::size_t index, const std::vector<Eigen::Matrix3Xd>& results) const {
+  const std::vector<std::size_t> sources = secant_miss_sources(index);
+  if (sources.empty() || results.size() != sources.size()) {
+    throw std::logic_error("ProtocolRunner::secant_miss_of: step " + std::to_string(index) +
+                           " keeps no miss, or the results do not match its sources");
+  }
+  const StepSpec& step = steps_[index];
+  const Eigen::Matrix3Xd& zero_load = results.back();
+  // The step's start as run_next_step made it: the previous result with this step's faces.
+  Eigen::Matrix3Xd previous = results[1];
+  spec_.protocol->load(system_.lattice(), step, zero_load).constraints.apply(previous);
+  const Eigen::Matrix3Xd secant = strain_secant(
+      step, previous, sources.size() == 4 ? results[2] : Eigen::Matrix3Xd(), zero_load);
+  return results[0] - secant;
+}
+
 std::string ProtocolRunner::predict_start(const StepSpec& step, const ProtocolState& state,
-                                          std::int64_t& evaluations) {
+                                          std::int64_t& evaluations, Eigen::Matrix3Xd& secant) {
   if (start_state(step, state) == nullptr) return step_start::kInitialLattice;
   if (step.load_index == 0) {
     if (spec_.solver.field_step_start != mc::FieldStepStart::extrapolated) {
@@ -180,35 +262,56 @@ std::string ProtocolRunner::predict_start(const StepSpec& step, const ProtocolSt
   }
   const Protocol& protocol = *spec_.protocol;
   const bool first_field = step.field_index == 0;
-  if (spec_.solver.load_step_start != mc::LoadStepStart::extrapolated ||
+  if (spec_.solver.load_step_start == mc::LoadStepStart::previous ||
       !protocol.loads_from_zero_load_state() || (step.load_index == 1 && first_field)) {
     return step_start::kPrevious;
   }
-  const lattice::Lattice& lat = system_.lattice();
   const Eigen::Matrix3Xd zero_load = state.references[step.field_index].load();
   Eigen::Matrix3Xd candidate;
   std::string kind;
   if (step.load_index >= 2) {
-    const StepSpec& previous = step_at(step.field_index, step.load_index - 1);
-    const Eigen::Matrix3Xd& x = system_.positions();
     // Through the field's result two load values back, x_{k-2} (the zero-load state at k = 2,
     // and where a checkpoint written before it was kept lacks it).
     const KeptPositions& kept = state.earlier_load_results.at(step.field_index);
     const bool local = step.load_index >= 3 && kept.cols() > 0;
-    const Eigen::Matrix3Xd loaded = local ? kept.load() : Eigen::Matrix3Xd();
-    const Eigen::Matrix3Xd& earlier = local ? loaded : zero_load;
-    const StepSpec& before = step_at(step.field_index, local ? step.load_index - 2 : 0);
-    candidate = secant_start(x, earlier, protocol.measured_strain(lat, step, x, zero_load),
-                             protocol.measured_strain(lat, previous, x, zero_load),
-                             protocol.measured_strain(lat, before, earlier, zero_load));
+    secant = strain_secant(step, system_.positions(), local ? kept.load() : Eigen::Matrix3Xd(),
+                           zero_load);
+    std::vector<Eigen::Matrix3Xd> candidates = corrected_secants(step, state, secant);
+    if (!candidates.empty()) {
+      candidates.insert(candidates.begin(), secant);
+      evaluations += 1 + static_cast<std::int64_t>(candidates.size());
+      const int taken = take_lowest(system_, candidates);
+      if (taken < 0) return step_start::kPredictionRejected;
+      return taken == 0 ? step_start::kSecant : step_start::kCorrectedSecant;
+    }
+    candidate = secant;
     kind = step_start::kSecant;
   } else {
     // Load value 1: the previous field has just relaxed it (its slot) from its reference.
     const std::size_t neighbour = step.field_index - 1;
+    const auto response_at = [&](std::size_t field) -> Eigen::Matrix3Xd {
+      return state.slots[slot_of_field(field)].positions.load() - state.references[field].load();
+    };
     candidate =
         neighbour_field_start(zero_load, state.slots[slot_of_field(neighbour)].positions.load(),
                               state.references[neighbour].load());
     kind = step_start::kNeighbourField;
+    if (step.field_index >= 2 && corrects_load_starts()) {
+      // The two previous fields' responses, extrapolated in the field (load_step_start.hpp).
+      const Eigen::Vector3d& b_previous = step_at(neighbour, 1).field;
+      const Eigen::Vector3d& b_earlier = step_at(neighbour - 1, 1).field;
+      if (b_previous != b_earlier) {
+        std::vector<Eigen::Matrix3Xd> candidates;
+        candidates.push_back(std::move(candidate));
+        candidates.push_back(zero_load + field_secant_start(response_at(neighbour),
+                                                            response_at(neighbour - 1), step.field,
+                                                            b_previous, b_earlier));
+        evaluations += 3;
+        const int taken = take_lowest(system_, candidates);
+        if (taken < 0) return step_start::kPredictionRejected;
+        return taken == 0 ? step_start::kNeighbourField : step_start::kNeighbourFieldSecant;
+      }
+    }
   }
   // The start with the lower potential, both with this step's faces and field.
   evaluations += 2;
@@ -291,7 +394,13 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   StepRecord record;
   record.step = step;
   std::int64_t prediction_evaluations = 0;
-  record.start = predict_start(step, state, prediction_evaluations);
+  Eigen::Matrix3Xd secant;
+  record.start = predict_start(step, state, prediction_evaluations, secant);
+  // Where the next step takes this step's secant miss, the secant waits in the scratch file
+  // (where there is one) while the step relaxes.
+  KeptPositions kept_secant;
+  if (next_step_takes_miss(state.next_step)) kept_secant = std::move(secant);
+  if (state.spill) kept_secant.park(state.spill);
   keep_load_start(*this, state, step.field_index, std::move(load_start));
   // The secant has been made: its earlier point is not held while the step relaxes (this step's
   // start takes its place after the step).
@@ -339,6 +448,15 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
                                step.load_index > 0 ? reference_of_field() : system_.positions());
 
   // Advance the state.
+  // The misses the next step, the next field's at this load value, may add to its secant.
+  if (kept_secant.cols() > 0) {
+    state.earlier_secant_miss = std::move(state.secant_miss);
+    state.secant_miss = Eigen::Matrix3Xd(system_.positions() - kept_secant.load());
+    park_kept_positions(state);
+  } else {
+    state.secant_miss = KeptPositions();
+    state.earlier_secant_miss = KeptPositions();
+  }
   if (keeps_earlier_field_result()) state.earlier_field_result = std::move(start_to_keep);
   slot.positions = system_.positions();
   slot.magnetization = system_.magnetizations();

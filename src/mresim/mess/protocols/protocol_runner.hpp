@@ -107,6 +107,12 @@ struct ProtocolState {
   // loaded step, i.e. its result at the load value before the one its slot holds (0 columns:
   // none yet), the earlier point of the next strain step's secant (load_step_start.hpp).
   std::vector<KeptPositions> earlier_load_results;
+  // The same runs, between the steps of one load value: how far the last step's result lies
+  // from its strain secant, x_k(f) - S_k(f) (secant_miss), and the step's before it, at field
+  // f - 1 (earlier_secant_miss); 0 columns: none. Kept only where the next step is field
+  // f + 1's at the same load value, whose secant they correct (load_step_start.hpp).
+  KeptPositions secant_miss;
+  KeptPositions earlier_secant_miss;
   std::vector<StepRecord> records;  // of steps 0 .. next_step - 1
   // Where the multilevel preconditioner the next step may keep was built (solvers/
   // preconditioner_cache.hpp), shared with the runner's cache; null: none (the next step builds
@@ -136,6 +142,28 @@ class ProtocolRunner {
   // solver.load_step_start = "extrapolated"): after a loaded step at field f it holds that
   // field's result at the load value before.
   bool keeps_earlier_load_results() const;
+  // Whether its loaded steps are also offered the starts corrected by the previous fields
+  // (solver.load_step_start = "extrapolated"; load_step_start.hpp).
+  bool corrects_load_starts() const;
+
+  // The strain secant a loaded step at load value k >= 2 is offered (load_step_start.hpp): from
+  // `previous`, the field's result at k - 1 with the step's faces put on, through `earlier`, its
+  // result at k - 2 (0 columns: through `zero_load`, the field's zero-load state).
+  Eigen::Matrix3Xd strain_secant(const StepSpec& step, const Eigen::Matrix3Xd& previous,
+                                 const Eigen::Matrix3Xd& earlier,
+                                 const Eigen::Matrix3Xd& zero_load) const;
+  // Whether step `index`'s secant miss is kept for the step after it (ProtocolState::
+  // secant_miss): that step is the next field's at the same load value k >= 2.
+  bool next_step_takes_miss(std::size_t index) const;
+  // The steps whose results secant_miss_of reads to recompute step `index`'s secant miss (a
+  // rebuilt state, restart/saved_run.hpp): the step itself, its field's at the load value
+  // before, at the one before that (k >= 3), and its zero-load step, in this order. Empty where
+  // the step keeps no miss for the step after it.
+  std::vector<std::size_t> secant_miss_sources(std::size_t index) const;
+  // Step `index`'s secant miss, bit for bit as the run kept it, from the results of
+  // secant_miss_sources(index), in that order.
+  Eigen::Matrix3Xd secant_miss_of(std::size_t index,
+                                  const std::vector<Eigen::Matrix3Xd>& results) const;
 
   // Runs step state.next_step and advances the state. Throws std::logic_error past the end.
   const StepRecord& run_next_step(ProtocolState& state);
@@ -180,8 +208,14 @@ class ProtocolRunner {
   // step (solver.field_step_start) by its prediction (load_step_start.hpp) where that has no
   // higher potential. Call with the step's field and boundary set. Returns how the step starts
   // (step_start::); adds the evaluations it made to `evaluations`.
+  // A loaded step's strain secant (strain_secant) is left in `secant` (else 3 x 0).
   std::string predict_start(const StepSpec& step, const ProtocolState& state,
-                            std::int64_t& evaluations);
+                            std::int64_t& evaluations, Eigen::Matrix3Xd& secant);
+  // The corrected secants a loaded step is offered besides `secant` (load_step_start.hpp): none
+  // without the previous field's miss; with it S + m_{f-1}, and with the miss before it too
+  // S + m_{f-1} + r (m_{f-1} - m_{f-2}).
+  std::vector<Eigen::Matrix3Xd> corrected_secants(const StepSpec& step, const ProtocolState& state,
+                                                  const Eigen::Matrix3Xd& secant) const;
   // The field secant's start for a field step (load_step_start.hpp), or an empty array where
   // it has no two earlier fields' results.
   Eigen::Matrix3Xd field_secant_candidate(const StepSpec& step, const ProtocolState& state) const;

@@ -118,14 +118,20 @@ struct StateSources {
   std::vector<std::optional<std::size_t>> references;
   std::optional<std::size_t> earlier_field_result;
   std::vector<std::optional<std::size_t>> earlier_load_results;
+  // The steps whose secant misses the state holds (ProtocolState::secant_miss,
+  // earlier_secant_miss).
+  std::optional<std::size_t> secant_miss;
+  std::optional<std::size_t> earlier_secant_miss;
 };
 
 StateSources sources_after(const SavedRun& saved, const ProtocolRunner& runner,
                            const ProtocolState& initial, std::size_t count) {
-  StateSources sources{
-      std::vector<std::optional<std::size_t>>(initial.slots.size()),
-      std::vector<std::optional<std::size_t>>(initial.references.size()), std::nullopt,
-      std::vector<std::optional<std::size_t>>(initial.earlier_load_results.size())};
+  StateSources sources{std::vector<std::optional<std::size_t>>(initial.slots.size()),
+                       std::vector<std::optional<std::size_t>>(initial.references.size()),
+                       std::nullopt,
+                       std::vector<std::optional<std::size_t>>(initial.earlier_load_results.size()),
+                       std::nullopt,
+                       std::nullopt};
   if (runner.keeps_earlier_field_result() && count >= 2) sources.earlier_field_result = count - 2;
   for (std::size_t k = 0; k < count; ++k) {
     const StepSpec& step = saved.steps[k];
@@ -139,6 +145,13 @@ StateSources sources_after(const SavedRun& saved, const ProtocolRunner& runner,
       sources.references.at(step.field_index) = k;
     }
   }
+  // A step keeps its miss only for the step after it (ProtocolRunner::next_step_takes_miss).
+  if (count >= 1 && runner.next_step_takes_miss(count - 1)) {
+    sources.secant_miss = count - 1;
+    if (count >= 2 && runner.next_step_takes_miss(count - 2)) {
+      sources.earlier_secant_miss = count - 2;
+    }
+  }
   return sources;
 }
 
@@ -147,12 +160,34 @@ bool kept(const SavedRun& saved, const std::vector<std::optional<std::size_t>>& 
                              [&](const auto& k) { return !k || saved.positions.contains(*k); });
 }
 
+// The results a secant miss is recomputed from (ProtocolRunner::secant_miss_sources).
+std::vector<std::optional<std::size_t>> miss_sources(const ProtocolRunner& runner,
+                                                     const std::optional<std::size_t>& step) {
+  std::vector<std::optional<std::size_t>> sources;
+  if (!step) return sources;
+  for (const std::size_t k : runner.secant_miss_sources(*step)) sources.emplace_back(k);
+  return sources;
+}
+
 bool restorable(const SavedRun& saved, const ProtocolRunner& runner, const ProtocolState& initial,
                 std::size_t count) {
   if (count > saved.records.size() || count > saved.steps.size()) return false;
   const StateSources sources = sources_after(saved, runner, initial, count);
   return kept(saved, sources.slots) && kept(saved, sources.references) &&
-         kept(saved, {sources.earlier_field_result}) && kept(saved, sources.earlier_load_results);
+         kept(saved, {sources.earlier_field_result}) && kept(saved, sources.earlier_load_results) &&
+         kept(saved, miss_sources(runner, sources.secant_miss)) &&
+         kept(saved, miss_sources(runner, sources.earlier_secant_miss));
+}
+
+// Step `step`'s secant miss recomputed from the saved results; none without a step.
+KeptPositions recomputed_miss(const SavedRun& saved, const ProtocolRunner& runner,
+                              const std::optional<std::size_t>& step) {
+  if (!step) return {};
+  std::vector<Eigen::Matrix3Xd> results;
+  for (const std::size_t k : runner.secant_miss_sources(*step)) {
+    results.push_back(saved.positions.at(k).load());
+  }
+  return runner.secant_miss_of(*step, results);
 }
 
 // Whether a run continued from the state after `count` steps builds or keeps the multilevel
@@ -199,6 +234,9 @@ std::optional<ProtocolState> state_after(const SavedRun& saved, const ProtocolRu
   if (sources.earlier_field_result) {
     state.earlier_field_result = saved.positions.at(*sources.earlier_field_result).load();
   }
+  state.secant_miss = recomputed_miss(saved, runner, sources.secant_miss);
+  state.earlier_secant_miss = recomputed_miss(saved, runner, sources.earlier_secant_miss);
+  runner.park_kept_positions(state);
   if (count == saved.steps.size()) state.preconditioner_anchor = saved.final_anchor;
   state.records.assign(saved.records.begin(),
                        saved.records.begin() + static_cast<std::ptrdiff_t>(count));

@@ -287,11 +287,22 @@ void describe_solver(const MessSpec& s, app::InfoReport& r) {
     r.add(sec, "drag", v.leapfrog.drag, "1/t_c");
   }
   if (s.protocol->loads_from_zero_load_state()) {
-    const bool extrapolated = v.load_step_start == LoadStepStart::extrapolated;
-    r.add_text(sec, "load_step_start", extrapolated ? "extrapolated" : "previous",
-               extrapolated ? "each strain starts from a prediction (the secant through the "
-                              "zero-strain state, or the previous field's response)"
-                            : "each strain starts from the previous one's state (the original)");
+    switch (v.load_step_start) {
+      case LoadStepStart::extrapolated:
+        r.add_text(sec, "load_step_start", "extrapolated",
+                   "each strain starts from a prediction (the strain secant, or the previous "
+                   "field's response), corrected by the previous fields' misses of theirs");
+        break;
+      case LoadStepStart::secant:
+        r.add_text(sec, "load_step_start", "secant",
+                   "each strain starts from the strain secant, or the previous field's "
+                   "response, uncorrected");
+        break;
+      case LoadStepStart::previous:
+        r.add_text(sec, "load_step_start", "previous",
+                   "each strain starts from the previous one's state (the original)");
+        break;
+    }
   }
   const bool field_extrapolated = v.field_step_start == FieldStepStart::extrapolated;
   r.add_text(sec, "field_step_start", field_extrapolated ? "extrapolated" : "previous",
@@ -323,9 +334,12 @@ void describe_memory(const MessSpec& s, app::InfoReport& r) {
   if (scratch_bytes_per_node(s) > 0) {
     r.add("memory", "scratch_disk",
           static_cast<double>(scratch_bytes_per_node(s) * s.geometry.node_count()) / kMiB, "MiB",
-          fmt::format("{} bytes per node: the {} fields' latest and zero-load states, kept in an "
-                      "unnamed scratch file beside the results while other fields run",
-                      scratch_bytes_per_node(s), s.field.values.size()));
+          fmt::format("{} bytes per node at most: the {} fields' latest and zero-load states{}, "
+                      "kept in an unnamed scratch file beside the results while other fields run",
+                      scratch_bytes_per_node(s), s.field.values.size(),
+                      s.keeps_earlier_load_results()
+                          ? ", their results at the strain before and the strain secants' misses"
+                          : ""));
   }
   const AvailableMemory available = available_memory();
   if (available.bytes) {

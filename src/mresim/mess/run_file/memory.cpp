@@ -63,9 +63,11 @@ std::int64_t bytes_per_node(const MessSpec& spec) {
 }
 
 std::int64_t scratch_bytes_per_node(const MessSpec& spec) {
-  return spec.load_step_count() > 1
-             ? kPerFieldScratchBytesPerNode * static_cast<std::int64_t>(spec.field.values.size())
-             : 0;
+  if (spec.load_step_count() <= 1) return 0;
+  const auto fields = static_cast<std::int64_t>(spec.field.values.size());
+  if (!spec.keeps_earlier_load_results()) return kPerFieldScratchBytesPerNode * fields;
+  return (kPerFieldScratchBytesPerNode + kEarlierLoadScratchBytesPerNode) * fields +
+         kSecantScratchBytesPerNode;
 }
 
 std::int64_t estimated_memory_bytes(const MessSpec& spec) {

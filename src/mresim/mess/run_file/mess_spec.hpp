@@ -170,9 +170,11 @@ struct LeapfrogSettings {
 std::optional<double> leapfrog_stability_limit(int discretization_order);
 
 // Where a loaded step of a strain run starts (protocols/load_step_start.hpp): from a
-// prediction (the secant through the zero-strain state, or the previous field's response), or
-// from the previous load value's state as it is (the original code).
-enum class LoadStepStart { extrapolated, previous };
+// prediction (the strain secant or the previous field's response, each also corrected by the
+// previous fields: extrapolated), from the prediction without those corrections (secant, the
+// default before them, kept to measure against), or from the previous load value's state as it
+// is (previous, the original code).
+enum class LoadStepStart { extrapolated, secant, previous };
 
 // Where a field step (every step of a field loop or series; the zero-load steps of strain and
 // stress runs) from the third field on starts (protocols/load_step_start.hpp): from the secant
@@ -358,8 +360,14 @@ inline constexpr std::int64_t kFixedBytes = 32LL << 20;
 // measured in memory, the full-size Fig. 4.25 helix (993,168 nodes) grew by these 48 bytes per
 // node with every field.
 inline constexpr std::int64_t kPerFieldScratchBytesPerNode = 48;
-// The scratch file's size per node at the end of the run: kPerFieldScratchBytesPerNode x fields
-// for runs with more than one load value, else 0. On disk; not part of the memory estimate.
+// Strain runs with solver.load_step_start = "extrapolated" keep a third array per field there
+// (the result at the load value before, ProtocolState::earlier_load_results) and, for the
+// run, the step's secant while it relaxes and the two previous fields' secant misses.
+inline constexpr std::int64_t kEarlierLoadScratchBytesPerNode = 24;
+inline constexpr std::int64_t kSecantScratchBytesPerNode = 72;
+// The scratch file's size per node at most: kPerFieldScratchBytesPerNode x fields for runs with
+// more than one load value (plus the arrays above where the run keeps them), else 0. On disk;
+// not part of the memory estimate.
 std::int64_t scratch_bytes_per_node(const MessSpec& spec);
 
 // kFixedBytes + bytes_per_node x nodes + the magnetization solve's

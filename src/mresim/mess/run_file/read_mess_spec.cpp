@@ -549,9 +549,10 @@ void read_solver(const std::optional<TableReader>& solver, bool demagnetization,
            "only read with run.type = \"mess_strain\" (the runs whose load steps start from the "
            "previous load value)");
   }
-  s.load_step_start = t.enumeration_or(
-      "load_step_start", start_default,
-      {{"extrapolated", LoadStepStart::extrapolated}, {"previous", LoadStepStart::previous}});
+  s.load_step_start = t.enumeration_or("load_step_start", start_default,
+                                       {{"extrapolated", LoadStepStart::extrapolated},
+                                        {"secant", LoadStepStart::secant},
+                                        {"previous", LoadStepStart::previous}});
   s.field_step_start = t.enumeration_or(
       "field_step_start",
       s.method == SolverMethod::leapfrog ? FieldStepStart::previous : FieldStepStart::extrapolated,
@@ -829,7 +830,7 @@ std::size_t MessSpec::load_step_count() const { return protocol->load_values().s
 std::size_t MessSpec::relaxation_count() const { return field.values.size() * load_step_count(); }
 
 bool MessSpec::keeps_earlier_load_results() const {
-  return solver.load_step_start == LoadStepStart::extrapolated && load_step_count() > 1 &&
+  return solver.load_step_start != LoadStepStart::previous && load_step_count() > 1 &&
          protocol->loads_from_zero_load_state();
 }
 
