@@ -199,15 +199,15 @@ std::vector<Eigen::Matrix3Xd> ProtocolRunner::corrected_secants(
   if (state.secant_miss.cols() == 0 || !is_field_before(1, 1)) return candidates;
   // The previous field's miss, m_{f-1}.
   const Eigen::Matrix3Xd miss = state.secant_miss.load();
-  candidates.push_back(secant + miss);
+  candidates.emplace_back(secant + miss);
   if (state.earlier_secant_miss.cols() == 0 || !is_field_before(2, 2)) return candidates;
   // m_{f-1} + r (m_{f-1} - m_{f-2}): the miss extrapolated in the field, as the field secant
   // extrapolates the states.
   const Eigen::Vector3d& b_previous = state.records.back().step.field;
   const Eigen::Vector3d& b_earlier = state.records[state.records.size() - 2].step.field;
   if (b_previous == b_earlier) return candidates;
-  candidates.push_back(secant + field_secant_start(miss, state.earlier_secant_miss.load(),
-                                                   step.field, b_previous, b_earlier));
+  candidates.emplace_back(secant + field_secant_start(miss, state.earlier_secant_miss.load(),
+                                                      step.field, b_previous, b_earlier));
   return candidates;
 }
 
@@ -303,9 +303,9 @@ std::string ProtocolRunner::predict_start(const StepSpec& step, const ProtocolSt
       if (b_previous != b_earlier) {
         std::vector<Eigen::Matrix3Xd> candidates;
         candidates.push_back(std::move(candidate));
-        candidates.push_back(zero_load + field_secant_start(response_at(neighbour),
-                                                            response_at(neighbour - 1), step.field,
-                                                            b_previous, b_earlier));
+        candidates.emplace_back(zero_load + field_secant_start(response_at(neighbour),
+                                                               response_at(neighbour - 1),
+                                                               step.field, b_previous, b_earlier));
         evaluations += 3;
         const int taken = take_lowest(system_, candidates);
         if (taken < 0) return step_start::kPredictionRejected;
@@ -340,6 +340,21 @@ void keep_load_start(const ProtocolRunner& runner, ProtocolState& state, std::si
   runner.park_kept_positions(state);
 }
 
+// After a loaded step whose secant `secant` the next step's correction needs (else none): the
+// step's result minus it becomes the state's secant miss, the miss before it the earlier one
+// (ProtocolState::secant_miss); otherwise the state keeps none.
+void keep_secant_miss(const ProtocolRunner& runner, ProtocolState& state,
+                      const Eigen::Matrix3Xd& result, const KeptPositions& secant) {
+  if (secant.cols() == 0) {
+    state.secant_miss = KeptPositions();
+    state.earlier_secant_miss = KeptPositions();
+    return;
+  }
+  state.earlier_secant_miss = std::move(state.secant_miss);
+  state.secant_miss = Eigen::Matrix3Xd(result - secant.load());
+  runner.park_kept_positions(state);
+}
+
 // The step's magnetization solves (since `before`) and its final solve; a step converges only
 // if that solve did.
 void record_magnetization(const mess::MessSystem& system, const mess::MagnetizationStats& before,
@@ -356,6 +371,39 @@ void record_magnetization(const mess::MessSystem& system, const mess::Magnetizat
 }
 
 }  // namespace
+
+void ProtocolRunner::relax(const StepSpec& step, StepRecord& record) {
+  if (spec_.solver.method != mc::SolverMethod::leapfrog) {
+    const mess::MinimiserResult r = mess::minimise(system_, minimiser_options());
+    record.converged = r.converged;
+    record.status = to_string(r.status);
+    record.iterations = r.iterations;
+    record.evaluations = r.evaluations;
+    record.krylov_iterations = r.krylov_iterations;
+    record.finished_by = finished_by_name(r, spec_.solver.method == mc::SolverMethod::newton);
+    record.correction_passes = r.correction_passes;
+    if (!r.state_preconditioner.empty()) record.preconditioner = r.state_preconditioner;
+    record.max_force = r.max_force;
+    record.energies = r.final.energies;
+    return;
+  }
+  mess::LeapfrogOptions options = spec_.profile->leapfrog_options();
+  options.time_step = spec_.solver.leapfrog.dt;
+  options.steps_per_round = static_cast<int>(spec_.solver.leapfrog.steps_per_round);
+  options.max_rounds = static_cast<int>(spec_.solver.leapfrog.max_rounds);
+  options.drag = spec_.solver.leapfrog.drag;
+  options.observer = observer_;
+  // docs/original-code.md#convergence: at zero field and zero load one round may end the step.
+  options.first_round_may_end = step.field.norm() < 1e-12 && step.load_value == 0.0;
+  const mess::LeapfrogResult r = mess::relax_leapfrog(system_, options);
+  record.converged = r.converged;
+  record.status = to_string(r.status);
+  record.iterations = r.steps;
+  record.evaluations = r.steps + 1;
+  record.finished_by = "leapfrog";
+  record.max_force = r.history.empty() ? 0.0 : r.history.back().mean_abs_acceleration;
+  record.energies = r.final.energies;
+}
 
 const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   if (state.next_step >= steps_.size()) {
@@ -405,37 +453,8 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
   // The secant has been made: its earlier point is not held while the step relaxes (this step's
   // start takes its place after the step).
   if (keeps_earlier_field_result()) state.earlier_field_result = KeptPositions();
-  const double b = step.field.norm();
-  if (spec_.solver.method != mc::SolverMethod::leapfrog) {
-    const mess::MinimiserResult r = mess::minimise(system_, minimiser_options());
-    record.converged = r.converged;
-    record.status = to_string(r.status);
-    record.iterations = r.iterations;
-    record.evaluations = r.evaluations + prediction_evaluations;
-    record.krylov_iterations = r.krylov_iterations;
-    record.finished_by = finished_by_name(r, spec_.solver.method == mc::SolverMethod::newton);
-    record.correction_passes = r.correction_passes;
-    if (!r.state_preconditioner.empty()) record.preconditioner = r.state_preconditioner;
-    record.max_force = r.max_force;
-    record.energies = r.final.energies;
-  } else {
-    mess::LeapfrogOptions options = spec_.profile->leapfrog_options();
-    options.time_step = spec_.solver.leapfrog.dt;
-    options.steps_per_round = static_cast<int>(spec_.solver.leapfrog.steps_per_round);
-    options.max_rounds = static_cast<int>(spec_.solver.leapfrog.max_rounds);
-    options.drag = spec_.solver.leapfrog.drag;
-    options.observer = observer_;
-    // docs/original-code.md#convergence: at zero field and zero load one round may end the step.
-    options.first_round_may_end = b < 1e-12 && step.load_value == 0.0;
-    const mess::LeapfrogResult r = mess::relax_leapfrog(system_, options);
-    record.converged = r.converged;
-    record.status = to_string(r.status);
-    record.iterations = r.steps;
-    record.evaluations = r.steps + 1 + prediction_evaluations;
-    record.finished_by = "leapfrog";
-    record.max_force = r.history.empty() ? 0.0 : r.history.back().mean_abs_acceleration;
-    record.energies = r.final.energies;
-  }
+  relax(step, record);
+  record.evaluations += prediction_evaluations;
 
   record_magnetization(system_, before, record);
 
@@ -448,15 +467,7 @@ const StepRecord& ProtocolRunner::run_next_step(ProtocolState& state) {
                                step.load_index > 0 ? reference_of_field() : system_.positions());
 
   // Advance the state.
-  // The misses the next step, the next field's at this load value, may add to its secant.
-  if (kept_secant.cols() > 0) {
-    state.earlier_secant_miss = std::move(state.secant_miss);
-    state.secant_miss = Eigen::Matrix3Xd(system_.positions() - kept_secant.load());
-    park_kept_positions(state);
-  } else {
-    state.secant_miss = KeptPositions();
-    state.earlier_secant_miss = KeptPositions();
-  }
+  keep_secant_miss(*this, state, system_.positions(), kept_secant);
   if (keeps_earlier_field_result()) state.earlier_field_result = std::move(start_to_keep);
   slot.positions = system_.positions();
   slot.magnetization = system_.magnetizations();

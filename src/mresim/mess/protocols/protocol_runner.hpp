@@ -220,6 +220,9 @@ class ProtocolRunner {
   // it has no two earlier fields' results.
   Eigen::Matrix3Xd field_secant_candidate(const StepSpec& step, const ProtocolState& state) const;
 
+  // Relaxes the system from its start with the run file's method; fills the record's solver
+  // fields (its evaluations: the relaxation's own).
+  void relax(const StepSpec& step, StepRecord& record);
   // The run file's solver settings for one relaxation, with the run's caches.
   mess::MinimiserOptions minimiser_options() const;
 
