@@ -173,14 +173,18 @@ TEST(LoadStepStart, TheLowestOfSeveralCandidatesIsTakenWithItsMagnetization) {
   EXPECT_EQ(system.magnetizations(), magnetization);
 }
 
-// The small pair (support/small_runs.hpp) sheared at two fields through four strains.
-std::string small_shear(const std::string& start) {
+// The small pair (support/small_runs.hpp) sheared at the fields `magnitudes` (T, a TOML
+// array) through four strains; `start`: solver.load_step_start (empty: the default).
+std::string sheared_pair(const std::string& magnitudes, const std::string& start) {
   return std::string("[run]\ntype = \"mess_strain\"\n") + testing::kSmallModel +
-         "\n[field]\nmagnitudes = [0.0, 0.05]\n"
-         "\n[strain]\nkind = \"shear\"\nnormal = \"z\"\ndirection = \"x\"\n"
+         "\n[field]\nmagnitudes = " + magnitudes +
+         "\n\n[strain]\nkind = \"shear\"\nnormal = \"z\"\ndirection = \"x\"\n"
          "max = 0.02\nsteps = 4\n" +
          (start.empty() ? "" : "\n[solver]\nload_step_start = \"" + start + "\"\n");
 }
+
+// At two fields (10 steps, step n = 2 k + f).
+std::string small_shear(const std::string& start) { return sheared_pair("[0.0, 0.05]", start); }
 
 TEST(LoadStepStart, PredictedStartsReachTheOriginalsStatesInFewerIterations) {
   const std::vector<StepRecord> previous = testing::records_of_run(small_shear("previous"));
@@ -262,13 +266,9 @@ TEST(LoadStepStart, EachLoadedStepKeepsItsStartForTheFieldsNextSecant) {
   EXPECT_TRUE(original.initial_state().earlier_load_results.empty());
 }
 
-// The small pair sheared at three fields through four strains (15 steps, step n = 3 k + f).
+// At three fields (15 steps, step n = 3 k + f).
 std::string three_field_shear(const std::string& start) {
-  return std::string("[run]\ntype = \"mess_strain\"\n") + testing::kSmallModel +
-         "\n[field]\nmagnitudes = [0.0, 0.05, 0.1]\n"
-         "\n[strain]\nkind = \"shear\"\nnormal = \"z\"\ndirection = \"x\"\n"
-         "max = 0.02\nsteps = 4\n" +
-         (start.empty() ? "" : "\n[solver]\nload_step_start = \"" + start + "\"\n");
+  return sheared_pair("[0.0, 0.05, 0.1]", start);
 }
 
 // From the second strain on, a later field's step is offered its secant corrected by the
