@@ -282,6 +282,44 @@ TEST(MultilevelCorrection, IsBitwiseTheSameOnEveryThreadCount) {
   omp_set_num_threads(threads);
 }
 
+// The build splits each level's points over the threads along z, each thread summing the terms
+// of its own band of lattice layers (multilevel_correction.hpp): at a deformed state of a box
+// longer along z, with two particles, every thread count gives bitwise the one-thread
+// correction (a term missing from a band, or summed twice, would change its sums).
+TEST(MultilevelCorrection, ItsBuildSplitOverTheThreadsIsBitwiseTheSameAtADeformedState) {
+  const mess::ModelProfile& profile = mess::model_profile("seed");
+  mess::MessSystem sys =
+      mess::MessSystem::make(small_lattice(profile, {20, 16, 60}, {{10, 8, 20}, {10, 8, 40}}),
+                             Eigen::Vector3d::Zero(), profile);
+  const lat::Lattice& l = sys.lattice();
+  ASSERT_GE(l.node_count(), 20000);  // the build's threads start from 20,000 nodes
+  sys.set_constraints(faces_held(l, {lat::Face::bottom, lat::Face::top}));
+  const mess::DofMap map(sys.constraints(), l.positions, l.element_length);
+  Eigen::Matrix3Xd x = l.positions;
+  std::mt19937 gen(23);
+  std::uniform_real_distribution<double> u(-0.1, 0.1);
+  for (Eigen::Index n = 0; n < x.cols(); ++n) {
+    for (int a = 0; a < 3; ++a) x(a, n) += u(gen) * l.element_length;
+  }
+  const double factor = sys.settings().elastic.volume_force_factor;
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const mess::MultilevelCorrection one_thread(l, factor, map, kForceScale, &x);
+  EXPECT_GE(one_thread.levels(), 3);
+  const Eigen::VectorXd v = uniform_random_vector(map.size(), 9);
+  const Eigen::VectorXd one = apply_correction(one_thread, map, v);
+  // The state changes it (else equal results could come from a build that ignored it).
+  const mess::MultilevelCorrection at_rest(l, factor, map, kForceScale);
+  EXPECT_GT((apply_correction(at_rest, map, v) - one).norm(), 1e-3 * one.norm());
+  for (const int t : {2, 3, 4, 7}) {
+    omp_set_num_threads(t);
+    const mess::MultilevelCorrection other(l, factor, map, kForceScale, &x);
+    omp_set_num_threads(1);
+    EXPECT_EQ(apply_correction(other, map, v), one) << t << " threads";
+  }
+  omp_set_num_threads(threads);
+}
+
 // With nothing held the lattice's rigid motions make the coarsest level singular: the
 // correction refuses, and the preconditioner goes on without it.
 TEST(MultilevelCorrection, IsLeftOutWhereNothingIsHeld) {

@@ -1,7 +1,10 @@
 #include "mresim/mess/solvers/multilevel_correction.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <exception>
 #include <stdexcept>
 #include <string>
@@ -216,14 +219,29 @@ std::vector<MultilevelCorrection::Level> MultilevelCorrection::build_levels(
 
 namespace {
 
-// Sums the rank-one terms c z z^T of the reference Hessian projected onto one level: the
-// diagonal always, and when the level is solved exactly the 3 x 3 blocks of each point with its
-// neighbours (<= kReach apart) that its sparse factor reads (the lower triangle).
+// The sums of one level: the diagonal of Phi^T A Phi (3 per point), and when the level is solved
+// exactly the 3 x 3 blocks of each point with its neighbours (<= kReach apart) that its sparse
+// factor reads (the lower triangle), kNeighbours per point.
+struct LevelSums {
+  std::vector<double> diagonal;
+  std::vector<double> blocks;
+};
+
+// Adds the rank-one terms c z z^T of the stiffness (stiffness_terms.hpp) projected onto one level
+// into the sums of the level points it owns: those whose index along z lies in [owned_first,
+// owned_end). Each owned sum takes every term in the order the terms come, so the threads that
+// split a level's points between them give each sum the bits one thread would.
 class LevelAssembler {
  public:
   LevelAssembler(const std::array<std::vector<int>, 3>& planes, const Dims& fine,
-                 const Dims& points, const DofMap& map, bool exact)
-      : fine_(fine), points_(points), map_(map) {
+                 const Dims& points, const DofMap& map, LevelSums& sums, int owned_first,
+                 int owned_end)
+      : fine_(fine),
+        points_(points),
+        map_(map),
+        sums_(sums),
+        owned_first_(owned_first),
+        owned_end_(owned_end) {
     // Each lattice plane's bracket on this level: the composition of the levels' linear
     // interpolations is the linear interpolation in lattice coordinates (nested grids).
     for (std::size_t a = 0; a < 3; ++a) {
@@ -231,13 +249,14 @@ class LevelAssembler {
       std::size_t j = 0;
       for (int f = 0; f < fine_[a]; ++f) {
         while (j + 2 < plane.size() && plane[j + 1] <= f) ++j;
+        const double t = static_cast<double>(f - plane[j]) / (plane[j + 1] - plane[j]);
         lower_[a].push_back(static_cast<int>(j));
-        upper_[a].push_back(static_cast<double>(f - plane[j]) / (plane[j + 1] - plane[j]));
+        upper_[a].push_back(t);
+        lower_weight_[a].push_back(1.0 - t);
       }
     }
-    const std::int64_t count = point_count(points_);
-    diagonal_.assign(static_cast<std::size_t>(3 * count), 0.0);
-    if (exact) blocks_.assign(static_cast<std::size_t>(count * kNeighbours * 9), 0.0);
+    inverse_nz_ = 1.0 / fine_[2];
+    inverse_nx_ = 1.0 / fine_[0];
   }
 
   // Starts a term over the lattice nodes `nodes` (then add_node(k, ...) for each k-th of them):
@@ -246,15 +265,14 @@ class LevelAssembler {
   // plane's bracket moves by at most one point from one lattice plane to the next).
   template <std::size_t Count>
   void start(const std::array<std::int64_t, Count>& nodes) {
-    for (const int p : touched_) is_touched_[static_cast<std::size_t>(p)] = false;
-    touched_.clear();
+    touched_count_ = 0;
+    touched_mask_ = 0;
     base_ = {points_[0], points_[1], points_[2]};
-    const auto nz = static_cast<std::int32_t>(fine_[2]);
-    const auto nx = static_cast<std::int32_t>(fine_[0]);
     for (std::size_t k = 0; k < Count; ++k) {
       const auto n = static_cast<std::int32_t>(nodes[k]);  // DofMap: 3 N fits 32 bits
-      const std::int32_t line = n / nz;
-      node_[k] = {line % nx, line / nx, n % nz};
+      const std::int32_t line = quotient(n, fine_[2], inverse_nz_);
+      const std::int32_t iy = quotient(line, fine_[0], inverse_nx_);
+      node_[k] = {line - iy * fine_[0], iy, n - line * fine_[2]};
       for (std::size_t a = 0; a < 3; ++a) {
         base_[a] = std::min(base_[a], lower_[a][static_cast<std::size_t>(node_[k][a])]);
         free_[k][a] = map_.own_dof_of_coordinate(3 * nodes[k] + static_cast<std::int64_t>(a)) >= 0;
@@ -264,70 +282,124 @@ class LevelAssembler {
 
   // z += sign direction_a phi_n for the free coordinates a of the k-th node n of start(). A
   // point's value is the sum of its nodes' parts in the order they come (as a list of entries
-  // merged by point would give it).
+  // merged by point would give it); each part's weight is sign times the x, y and z factors of
+  // the trilinear interpolation, multiplied in that order, and points of weight 0 are skipped.
   void add_node(std::size_t k, const Eigen::Vector3d& direction, double sign) {
     const std::array<int, 3>& i = node_[k];
-    for (int c = 0; c < 8; ++c) {
-      std::array<int, 3> offset{};
-      double w = sign;
-      for (std::size_t a = 0; a < 3; ++a) {
-        const bool up = ((c >> a) & 1) != 0;
-        const auto f = static_cast<std::size_t>(i[a]);
-        offset[a] = lower_[a][f] + (up ? 1 : 0) - base_[a];
-        w *= up ? upper_[a][f] : 1.0 - upper_[a][f];
+    // Per axis the patch offsets with a nonzero factor and their factors.
+    std::array<std::array<int, 2>, 3> offset{};
+    std::array<std::array<double, 2>, 3> factor{};
+    std::array<int, 3> count{};
+    for (std::size_t a = 0; a < 3; ++a) {
+      const auto f = static_cast<std::size_t>(i[a]);
+      const int low = lower_[a][f] - base_[a];
+      if (lower_weight_[a][f] != 0.0) {
+        offset[a][static_cast<std::size_t>(count[a])] = low;
+        factor[a][static_cast<std::size_t>(count[a]++)] = lower_weight_[a][f];
       }
-      if (w == 0.0) continue;
-      if (offset[0] > 2 || offset[1] > 2 || offset[2] > 2) {
+      if (upper_[a][f] != 0.0) {
+        offset[a][static_cast<std::size_t>(count[a])] = low + 1;
+        factor[a][static_cast<std::size_t>(count[a]++)] = upper_[a][f];
+      }
+      if (offset[a][static_cast<std::size_t>(count[a] - 1)] > 2) {
         throw std::logic_error("MultilevelCorrection: a term reaches beyond its 3 x 3 x 3 patch");
       }
-      std::array<double, 3> value{};
-      for (std::size_t a = 0; a < 3; ++a) {
-        if (free_[k][a]) value[a] = w * direction[static_cast<Eigen::Index>(a)];
-      }
-      const int p = 9 * offset[0] + 3 * offset[1] + offset[2];
-      auto& point = patch_[static_cast<std::size_t>(p)];
-      if (!is_touched_[static_cast<std::size_t>(p)]) {
-        is_touched_[static_cast<std::size_t>(p)] = true;
-        touched_.push_back(p);
-        point = value;
-      } else {
-        for (std::size_t a = 0; a < 3; ++a) point[a] += value[a];
-      }
     }
-  }
-
-  // Adds c z z^T.
-  void add_term(double c) {
-    std::array<std::int64_t, 27> node_of{};  // the level point of each touched patch point
-    for (const int p : touched_) node_of[static_cast<std::size_t>(p)] = point_of(p);
-    for (const int p : touched_) {
-      const auto& e = patch_[static_cast<std::size_t>(p)];
-      const std::int64_t node = node_of[static_cast<std::size_t>(p)];
-      for (std::size_t a = 0; a < 3; ++a) {
-        diagonal_[static_cast<std::size_t>(3 * node) + a] += c * e[a] * e[a];
-      }
-    }
-    if (blocks_.empty()) return;
-    // Only the blocks the factor reads: its sparse LDL^T takes the lower triangle, so point J
-    // needs the blocks of its neighbours K <= J (coordinates are numbered 3 J + a).
-    for (const int p : touched_) {
-      const auto& e = patch_[static_cast<std::size_t>(p)];
-      const std::int64_t node = node_of[static_cast<std::size_t>(p)];
-      for (const int q : touched_) {
-        if (node_of[static_cast<std::size_t>(q)] > node) continue;
-        const auto& f = patch_[static_cast<std::size_t>(q)];
-        // Patch offsets differ by at most 2 <= kReach along each axis.
-        const int code = (q / 9 - p / 9 + kReach) * kWidth * kWidth +
-                         ((q / 3) % 3 - (p / 3) % 3 + kReach) * kWidth + (q % 3 - p % 3 + kReach);
-        double* block = blocks_.data() + (node * kNeighbours + code) * 9;
-        for (std::size_t a = 0; a < 3; ++a) {
-          for (std::size_t b = 0; b < 3; ++b) block[3 * a + b] += c * e[a] * f[b];
+    for (std::size_t ex = 0; ex < static_cast<std::size_t>(count[0]); ++ex) {
+      const double wx = sign * factor[0][ex];
+      for (std::size_t ey = 0; ey < static_cast<std::size_t>(count[1]); ++ey) {
+        const double wxy = wx * factor[1][ey];
+        for (std::size_t ez = 0; ez < static_cast<std::size_t>(count[2]); ++ez) {
+          const double w = wxy * factor[2][ez];
+          std::array<double, 3> value{};
+          for (std::size_t a = 0; a < 3; ++a) {
+            if (free_[k][a]) value[a] = w * direction[static_cast<Eigen::Index>(a)];
+          }
+          const int p = 9 * offset[0][ex] + 3 * offset[1][ey] + offset[2][ez];
+          auto& point = patch_[static_cast<std::size_t>(p)];
+          const std::uint32_t bit = 1U << static_cast<unsigned>(p);
+          if ((touched_mask_ & bit) == 0) {
+            touched_mask_ |= bit;
+            touched_[static_cast<std::size_t>(touched_count_++)] = p;
+            point = value;
+          } else {
+            for (std::size_t a = 0; a < 3; ++a) point[a] += value[a];
+          }
         }
       }
     }
   }
 
-  const std::vector<double>& diagonal() const { return diagonal_; }
+  // Adds c z z^T to the owned points' sums.
+  void add_term(double c) {
+    // The level point of each touched patch point, and whether it is this assembler's.
+    std::array<std::int64_t, 27> node_of;  // NOLINT(cppcoreguidelines-pro-type-member-init)
+    std::array<bool, 27> owned;            // NOLINT(cppcoreguidelines-pro-type-member-init)
+    for (int t = 0; t < touched_count_; ++t) {
+      const int p = touched_[static_cast<std::size_t>(t)];
+      node_of[static_cast<std::size_t>(p)] = point_of(p);
+      const int jz = base_[2] + p % 3;
+      owned[static_cast<std::size_t>(p)] = jz >= owned_first_ && jz < owned_end_;
+    }
+    for (int t = 0; t < touched_count_; ++t) {
+      const int p = touched_[static_cast<std::size_t>(t)];
+      if (!owned[static_cast<std::size_t>(p)]) continue;
+      const auto& e = patch_[static_cast<std::size_t>(p)];
+      const std::int64_t node = node_of[static_cast<std::size_t>(p)];
+      for (std::size_t a = 0; a < 3; ++a) {
+        sums_.diagonal[static_cast<std::size_t>(3 * node) + a] += c * e[a] * e[a];
+      }
+    }
+    if (sums_.blocks.empty()) return;
+    // Only the blocks the factor reads: its sparse LDL^T takes the lower triangle, so point J
+    // needs the blocks of its neighbours K <= J (coordinates are numbered 3 J + a). Patch
+    // offsets differ by at most 2 <= kReach along each axis, so the neighbour code of q seen
+    // from p is code_of(q) - code_of(p) + code_of(kReach, kReach, kReach).
+    constexpr int kCentre = kReach * kWidth * kWidth + kReach * kWidth + kReach;
+    std::array<int, 27> code_of;  // NOLINT(cppcoreguidelines-pro-type-member-init)
+    for (int t = 0; t < touched_count_; ++t) {
+      const int p = touched_[static_cast<std::size_t>(t)];
+      code_of[static_cast<std::size_t>(p)] =
+          (p / 9) * kWidth * kWidth + ((p / 3) % 3) * kWidth + p % 3;
+    }
+    for (int t = 0; t < touched_count_; ++t) {
+      const int p = touched_[static_cast<std::size_t>(t)];
+      if (!owned[static_cast<std::size_t>(p)]) continue;
+      const auto& e = patch_[static_cast<std::size_t>(p)];
+      // (c e_a) f_b, as c * e_a * f_b evaluates.
+      const double ce0 = c * e[0];
+      const double ce1 = c * e[1];
+      const double ce2 = c * e[2];
+      const std::int64_t node = node_of[static_cast<std::size_t>(p)];
+      double* const row = sums_.blocks.data() +
+                          (node * kNeighbours + kCentre - code_of[static_cast<std::size_t>(p)]) * 9;
+      for (int s = 0; s < touched_count_; ++s) {
+        const int q = touched_[static_cast<std::size_t>(s)];
+        if (node_of[static_cast<std::size_t>(q)] > node) continue;
+        const auto& f = patch_[static_cast<std::size_t>(q)];
+        double* const block = row + std::ptrdiff_t{code_of[static_cast<std::size_t>(q)]} * 9;
+        block[0] += ce0 * f[0];
+        block[1] += ce0 * f[1];
+        block[2] += ce0 * f[2];
+        block[3] += ce1 * f[0];
+        block[4] += ce1 * f[1];
+        block[5] += ce1 * f[2];
+        block[6] += ce2 * f[0];
+        block[7] += ce2 * f[1];
+        block[8] += ce2 * f[2];
+      }
+    }
+  }
+
+ private:
+  // n / d for 0 <= n < 2^31 and d > 0 without a division instruction: the quotient of the
+  // floating-point product, corrected by one where it rounded across an integer.
+  static std::int32_t quotient(std::int32_t n, std::int32_t d, double inverse_d) {
+    auto q = static_cast<std::int32_t>(static_cast<double>(n) * inverse_d);
+    if (q * d > n) --q;
+    if ((q + 1) * d <= n) ++q;
+    return q;
+  }
   // Level point index of patch point p.
   std::int64_t point_of(int p) const {
     const std::int64_t jx = base_[0] + p / 9;
@@ -335,46 +407,89 @@ class LevelAssembler {
     const std::int64_t jz = base_[2] + p % 3;
     return jz + points_[2] * (jx + static_cast<std::int64_t>(points_[0]) * jy);
   }
-  const std::vector<double>& blocks() const { return blocks_; }
 
- private:
   Dims fine_;
   Dims points_;
   const DofMap& map_;
+  LevelSums& sums_;
+  int owned_first_;
+  int owned_end_;
+  double inverse_nz_ = 1.0;
+  double inverse_nx_ = 1.0;
+  // Per axis and lattice plane: the lower bracketing level point, and the interpolation's
+  // factors of the upper (t) and lower (1 - t) one.
   std::array<std::vector<int>, 3> lower_;
   std::array<std::vector<double>, 3> upper_;
+  std::array<std::vector<double>, 3> lower_weight_;
   // The current term: its nodes' grid coordinates and free coordinates, its patch's lowest
   // point, and its values on the patch (point 9 dx + 3 dy + dz) with the points it touched.
   std::array<std::array<int, 3>, 8> node_{};
   std::array<std::array<bool, 3>, 8> free_{};
   std::array<int, 3> base_{};
   std::array<std::array<double, 3>, 27> patch_{};
-  std::array<bool, 27> is_touched_{};
-  std::vector<int> touched_;
-  std::vector<double> diagonal_;
-  std::vector<double> blocks_;
+  std::array<int, 27> touched_{};
+  int touched_count_ = 0;
+  std::uint32_t touched_mask_ = 0;
 };
 
 // The stiffness terms of stiffness_terms.hpp, linearised at `state` (null: at rest), projected
-// onto one level.
-void add_stiffness(const lattice::Lattice& lattice, const Eigen::Matrix3Xd* state,
-                   const DofMap& map, double volume_force_factor, double scale,
-                   LevelAssembler& level) {
-  for_each_stiffness_term(
-      lattice, state, map, volume_force_factor, scale,
-      [&level](std::int64_t i, std::int64_t j, const Eigen::Vector3d& u, double c) {
-        level.start(std::array<std::int64_t, 2>{j, i});
-        level.add_node(0, u, 1.0);
-        level.add_node(1, u, -1.0);
-        level.add_term(c);
-      },
-      [&level](const auto& element, const lattice::CellVertices& g, double c) {
-        std::array<std::int64_t, 8> nodes{};
-        for (std::size_t v = 0; v < 8; ++v) nodes[v] = element[v];
-        level.start(nodes);
-        for (std::size_t v = 0; v < 8; ++v) level.add_node(v, g[v], 1.0);
-        level.add_term(c);
-      });
+// onto one level: the threads split the level's points along z, each summing the terms near its
+// own points, so the sums do not depend on the number of threads.
+LevelSums assemble_level(const lattice::Lattice& lattice, const Eigen::Matrix3Xd* state,
+                         const DofMap& map, double volume_force_factor, double scale,
+                         const std::array<std::vector<int>, 3>& planes, const Dims& points,
+                         bool exact) {
+  const Dims fine = lattice.shape.nodes;
+  const std::int64_t count = point_count(points);
+  LevelSums sums;
+  sums.diagonal.assign(static_cast<std::size_t>(3 * count), 0.0);
+  if (exact) sums.blocks.assign(static_cast<std::size_t>(count * kNeighbours * 9), 0.0);
+  const std::vector<int>& z_planes = planes[2];
+  const auto z_points = static_cast<int>(z_planes.size());
+  std::exception_ptr failure;
+#pragma omp parallel if (point_count(fine) >= 20000)
+  {
+    const int parts = omp_get_num_threads();
+    const int part = omp_get_thread_num();
+    // This thread's points: those on the lattice layers [part, part + 1) nz / parts along z (the
+    // longest axis of the chapter's boxes, so the terms that two threads both sweep are few).
+    const auto from_part = [&](int jz, int which) {
+      return static_cast<std::int64_t>(z_planes[static_cast<std::size_t>(jz)]) * parts >=
+             static_cast<std::int64_t>(which) * fine[2];
+    };
+    int first = 0;
+    while (first < z_points && !from_part(first, part)) ++first;
+    int end = first;
+    while (end < z_points && !from_part(end, part + 1)) ++end;
+    if (first < end) {
+      try {
+        LevelAssembler level(planes, fine, points, map, sums, first, end);
+        // The lattice layers whose terms reach these points: between the neighbouring points.
+        const int z_first = first > 0 ? z_planes[static_cast<std::size_t>(first) - 1] : 0;
+        const int z_last = end < z_points ? z_planes[static_cast<std::size_t>(end)] : fine[2] - 1;
+        for_each_stiffness_term_in_layers(
+            lattice, state, map, volume_force_factor, scale, z_first, z_last,
+            [&level](std::int64_t i, std::int64_t j, const Eigen::Vector3d& u, double c) {
+              level.start(std::array<std::int64_t, 2>{j, i});
+              level.add_node(0, u, 1.0);
+              level.add_node(1, u, -1.0);
+              level.add_term(c);
+            },
+            [&level](const auto& element, const lattice::CellVertices& g, double c) {
+              std::array<std::int64_t, 8> nodes{};
+              for (std::size_t v = 0; v < 8; ++v) nodes[v] = element[v];
+              level.start(nodes);
+              for (std::size_t v = 0; v < 8; ++v) level.add_node(v, g[v], 1.0);
+              level.add_term(c);
+            });
+      } catch (...) {
+#pragma omp critical(mresim_multilevel_assembly)
+        failure = std::current_exception();
+      }
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
+  return sums;
 }
 
 // The process that builds each level when `processes` share the build: the levels in build
@@ -397,11 +512,8 @@ std::vector<int> level_owners(std::int64_t count, int processes) {
 void MultilevelCorrection::assemble(const lattice::Lattice& lattice, double volume_force_factor,
                                     double scale, const DofMap& map, const Eigen::Matrix3Xd* state,
                                     const detail::BlockSplit* processes) {
-  // Each level sweeps all springs and cells, and the levels are independent: one thread per
-  // level, so that each level's sums come in the same order whatever the thread count. The
-  // coarsest level, which also sums its neighbour blocks, takes about as long as two others:
-  // it goes first, so that the other threads share the remaining levels meanwhile. Over
-  // several processes each builds its own levels (level_owners) and shares them.
+  // The levels one after the other, each split over the threads by its points (assemble_level).
+  // Over several processes each builds its own levels (level_owners) and shares them.
   std::exception_ptr failure;
   const auto count = static_cast<std::int64_t>(levels_.size());
   const bool shared = processes != nullptr && processes->processes() > 1;
@@ -409,7 +521,6 @@ void MultilevelCorrection::assemble(const lattice::Lattice& lattice, double volu
   const int rank = shared ? processes->rank() : 0;
   std::vector<double> coarsest;  // shared: the coarsest level's diagonal, then its blocks
   std::vector<char> failed(static_cast<std::size_t>(count), 0);
-#pragma omp parallel for schedule(dynamic, 1) if (point_count(fine_) >= 20000)
   for (std::int64_t order = 0; order < count; ++order) {
     const std::int64_t li = count - 1 - order;
     if (owner[static_cast<std::size_t>(li)] != rank) continue;
@@ -417,28 +528,25 @@ void MultilevelCorrection::assemble(const lattice::Lattice& lattice, double volu
       Level& level = levels_[static_cast<std::size_t>(li)];
       const bool exact = li + 1 == count;
       const std::int64_t points = point_count(level.points);
-      LevelAssembler assembler({level.axes[0].plane, level.axes[1].plane, level.axes[2].plane},
-                               fine_, level.points, map, exact);
-      add_stiffness(lattice, state, map, volume_force_factor, scale, assembler);
+      const LevelSums sums = assemble_level(
+          lattice, state, map, volume_force_factor, scale,
+          {level.axes[0].plane, level.axes[1].plane, level.axes[2].plane}, level.points, exact);
       if (exact) {
         if (shared) {
-          coarsest = assembler.diagonal();
-          coarsest.insert(coarsest.end(), assembler.blocks().begin(), assembler.blocks().end());
+          coarsest = sums.diagonal;
+          coarsest.insert(coarsest.end(), sums.blocks.begin(), sums.blocks.end());
         }
-        factor_coarsest(level.points, assembler.diagonal(), assembler.blocks());
+        factor_coarsest(level.points, sums.diagonal, sums.blocks);
         continue;
       }
       level.inverse_diagonal = Eigen::VectorXd::Zero(3 * points);
       for (std::int64_t q = 0; q < 3 * points; ++q) {
-        const double d = assembler.diagonal()[static_cast<std::size_t>(q)];
+        const double d = sums.diagonal[static_cast<std::size_t>(q)];
         if (d > 0.0) level.inverse_diagonal[q] = 1.0 / d;
       }
     } catch (...) {
-#pragma omp critical(mresim_multilevel_assembly)
-      {
-        failure = std::current_exception();
-        failed[static_cast<std::size_t>(li)] = 1;
-      }
+      failure = std::current_exception();
+      failed[static_cast<std::size_t>(li)] = 1;
     }
   }
   if (shared) share_levels(owner, *processes, coarsest, failed);

@@ -35,11 +35,15 @@
 // levels' fields. The free coordinates are read through the minimiser's DofMap, which add_to()
 // is given, instead of a copy of its map. Building it sweeps the lattice's springs and cells
 // once per level (each a rank-one term: stiffness_terms.hpp), projecting each term onto the
-// 3 x 3 x 3 level points around it, one thread per level, the coarsest (which also sums the
-// lower triangle of its neighbour blocks, all its sparse factor reads) first: about 1.5 s at
-// 285k nodes on 2 threads. It depends on the lattice, the free coordinates, the force scale and
-// the state; a run builds one at a relaxation's starting state and keeps it while the lattice
-// stays close to that state (PreconditionerCache, preconditioner_cache.hpp).
+// 3 x 3 x 3 level points around it; the coarsest level also sums the lower triangle of its
+// neighbour blocks (all its sparse factor reads), the larger part of the build. The threads
+// split each level's points along z, each sweeping the terms that reach its own points (a band
+// of lattice layers), so every sum takes its terms in index order whatever the number of
+// threads: about 6 s at 993k nodes on 2 threads, 8.5 s when each thread built whole levels
+// (bench/preconditioner_bench.cpp, docs/performance.md). It depends on the lattice, the free
+// coordinates, the force scale and the state; a run builds one at a relaxation's starting state and
+// keeps it while the lattice stays close to that state (PreconditionerCache,
+// preconditioner_cache.hpp).
 //
 // Over MPI processes (a BlockSplit of more than one process, docs/mpi.md) the levels are
 // built by different processes, each level by one, the coarsest by the first, and shared
