@@ -227,6 +227,58 @@ struct LevelSums {
   std::vector<double> blocks;
 };
 
+// The lattice nodes of one term (a spring's two, a cell's eight): their grid coordinates (x, y,
+// z), which of their coordinates are free, and the lowest and highest layer along z they reach.
+struct TermNodes {
+  std::array<std::array<int, 3>, 8> grid{};
+  std::array<std::array<bool, 3>, 8> free{};
+  std::size_t count = 0;
+  int z_low = 0;
+  int z_high = 0;
+};
+
+// Fills TermNodes from node indices, once per term for all levels.
+class NodeLocator {
+ public:
+  NodeLocator(const Dims& fine, const DofMap& map)
+      : fine_(fine), map_(map), inverse_nz_(1.0 / fine[2]), inverse_nx_(1.0 / fine[0]) {}
+
+  template <std::size_t Count>
+  void locate(const std::array<std::int64_t, Count>& nodes, TermNodes& term) const {
+    static_assert(Count <= 8);
+    term.count = Count;
+    term.z_low = fine_[2];
+    term.z_high = -1;
+    for (std::size_t k = 0; k < Count; ++k) {
+      const auto n = static_cast<std::int32_t>(nodes[k]);  // DofMap: 3 N fits 32 bits
+      const std::int32_t line = quotient(n, fine_[2], inverse_nz_);
+      const std::int32_t iy = quotient(line, fine_[0], inverse_nx_);
+      const int iz = n - line * fine_[2];
+      term.grid[k] = {line - iy * fine_[0], iy, iz};
+      term.z_low = std::min(term.z_low, iz);
+      term.z_high = std::max(term.z_high, iz);
+      for (std::size_t a = 0; a < 3; ++a) {
+        term.free[k][a] =
+            map_.own_dof_of_coordinate(3 * nodes[k] + static_cast<std::int64_t>(a)) >= 0;
+      }
+    }
+  }
+
+ private:
+  // n / d for 0 <= n < 2^31 and d > 0 without a division instruction: the quotient of the
+  // floating-point product, corrected by one where it rounded across an integer.
+  static std::int32_t quotient(std::int32_t n, std::int32_t d, double inverse_d) {
+    auto q = static_cast<std::int32_t>(static_cast<double>(n) * inverse_d);
+    if (q * d > n) --q;
+    if ((q + 1) * d <= n) ++q;
+    return q;
+  }
+  Dims fine_;
+  const DofMap& map_;
+  double inverse_nz_;
+  double inverse_nx_;
+};
+
 // Adds the rank-one terms c z z^T of the stiffness (stiffness_terms.hpp) projected onto one level
 // into the sums of the level points it owns: those whose index along z lies in [owned_first,
 // owned_end). Each owned sum takes every term in the order the terms come, so the threads that
@@ -234,11 +286,9 @@ struct LevelSums {
 class LevelAssembler {
  public:
   LevelAssembler(const std::array<std::vector<int>, 3>& planes, const Dims& fine,
-                 const Dims& points, const DofMap& map, LevelSums& sums, int owned_first,
-                 int owned_end)
+                 const Dims& points, LevelSums& sums, int owned_first, int owned_end)
       : fine_(fine),
         points_(points),
-        map_(map),
         sums_(sums),
         owned_first_(owned_first),
         owned_end_(owned_end) {
@@ -255,27 +305,20 @@ class LevelAssembler {
         lower_weight_[a].push_back(1.0 - t);
       }
     }
-    inverse_nz_ = 1.0 / fine_[2];
-    inverse_nx_ = 1.0 / fine_[0];
   }
 
-  // Starts a term over the lattice nodes `nodes` (then add_node(k, ...) for each k-th of them):
+  // Starts a term over the lattice nodes `term` (then add_node(k, ...) for each k-th of them):
   // its projection lives on the level points that bracket them, a patch of at most 3 along each
   // axis (springs and cells join lattice points at most one plane apart, and each coarser
   // plane's bracket moves by at most one point from one lattice plane to the next).
-  template <std::size_t Count>
-  void start(const std::array<std::int64_t, Count>& nodes) {
+  void start(const TermNodes& term) {
+    term_ = &term;
     touched_count_ = 0;
     touched_mask_ = 0;
     base_ = {points_[0], points_[1], points_[2]};
-    for (std::size_t k = 0; k < Count; ++k) {
-      const auto n = static_cast<std::int32_t>(nodes[k]);  // DofMap: 3 N fits 32 bits
-      const std::int32_t line = quotient(n, fine_[2], inverse_nz_);
-      const std::int32_t iy = quotient(line, fine_[0], inverse_nx_);
-      node_[k] = {line - iy * fine_[0], iy, n - line * fine_[2]};
+    for (std::size_t k = 0; k < term.count; ++k) {
       for (std::size_t a = 0; a < 3; ++a) {
-        base_[a] = std::min(base_[a], lower_[a][static_cast<std::size_t>(node_[k][a])]);
-        free_[k][a] = map_.own_dof_of_coordinate(3 * nodes[k] + static_cast<std::int64_t>(a)) >= 0;
+        base_[a] = std::min(base_[a], lower_[a][static_cast<std::size_t>(term.grid[k][a])]);
       }
     }
   }
@@ -285,7 +328,8 @@ class LevelAssembler {
   // merged by point would give it); each part's weight is sign times the x, y and z factors of
   // the trilinear interpolation, multiplied in that order, and points of weight 0 are skipped.
   void add_node(std::size_t k, const Eigen::Vector3d& direction, double sign) {
-    const std::array<int, 3>& i = node_[k];
+    const std::array<int, 3>& i = term_->grid[k];
+    const std::array<bool, 3>& free = term_->free[k];
     // Per axis the patch offsets with a nonzero factor and their factors.
     std::array<std::array<int, 2>, 3> offset{};
     std::array<std::array<double, 2>, 3> factor{};
@@ -313,7 +357,7 @@ class LevelAssembler {
           const double w = wxy * factor[2][ez];
           std::array<double, 3> value{};
           for (std::size_t a = 0; a < 3; ++a) {
-            if (free_[k][a]) value[a] = w * direction[static_cast<Eigen::Index>(a)];
+            if (free[a]) value[a] = w * direction[static_cast<Eigen::Index>(a)];
           }
           const int p = 9 * offset[0][ex] + 3 * offset[1][ey] + offset[2][ez];
           auto& point = patch_[static_cast<std::size_t>(p)];
@@ -392,14 +436,6 @@ class LevelAssembler {
   }
 
  private:
-  // n / d for 0 <= n < 2^31 and d > 0 without a division instruction: the quotient of the
-  // floating-point product, corrected by one where it rounded across an integer.
-  static std::int32_t quotient(std::int32_t n, std::int32_t d, double inverse_d) {
-    auto q = static_cast<std::int32_t>(static_cast<double>(n) * inverse_d);
-    if (q * d > n) --q;
-    if ((q + 1) * d <= n) ++q;
-    return q;
-  }
   // Level point index of patch point p.
   std::int64_t point_of(int p) const {
     const std::int64_t jx = base_[0] + p / 9;
@@ -410,21 +446,17 @@ class LevelAssembler {
 
   Dims fine_;
   Dims points_;
-  const DofMap& map_;
   LevelSums& sums_;
   int owned_first_;
   int owned_end_;
-  double inverse_nz_ = 1.0;
-  double inverse_nx_ = 1.0;
   // Per axis and lattice plane: the lower bracketing level point, and the interpolation's
   // factors of the upper (t) and lower (1 - t) one.
   std::array<std::vector<int>, 3> lower_;
   std::array<std::vector<double>, 3> upper_;
   std::array<std::vector<double>, 3> lower_weight_;
-  // The current term: its nodes' grid coordinates and free coordinates, its patch's lowest
-  // point, and its values on the patch (point 9 dx + 3 dy + dz) with the points it touched.
-  std::array<std::array<int, 3>, 8> node_{};
-  std::array<std::array<bool, 3>, 8> free_{};
+  // The current term: its nodes, its patch's lowest point, and its values on the patch (point
+  // 9 dx + 3 dy + dz) with the points it touched.
+  const TermNodes* term_ = nullptr;
   std::array<int, 3> base_{};
   std::array<std::array<double, 3>, 27> patch_{};
   std::array<int, 27> touched_{};
@@ -432,64 +464,103 @@ class LevelAssembler {
   std::uint32_t touched_mask_ = 0;
 };
 
-// The stiffness terms of stiffness_terms.hpp, linearised at `state` (null: at rest), projected
-// onto one level: the threads split the level's points along z, each summing the terms near its
-// own points, so the sums do not depend on the number of threads.
-LevelSums assemble_level(const lattice::Lattice& lattice, const Eigen::Matrix3Xd* state,
-                         const DofMap& map, double volume_force_factor, double scale,
-                         const std::array<std::vector<int>, 3>& planes, const Dims& points,
-                         bool exact) {
-  const Dims fine = lattice.shape.nodes;
-  const std::int64_t count = point_count(points);
+// One level to build: its lattice planes along each axis, its points, whether it is solved
+// exactly, and its sums.
+struct LevelBuild {
+  std::array<std::vector<int>, 3> planes;
+  Dims points{};
+  bool exact = false;
   LevelSums sums;
-  sums.diagonal.assign(static_cast<std::size_t>(3 * count), 0.0);
-  if (exact) sums.blocks.assign(static_cast<std::size_t>(count * kNeighbours * 9), 0.0);
-  const std::vector<int>& z_planes = planes[2];
-  const auto z_points = static_cast<int>(z_planes.size());
+};
+
+// The stiffness terms of stiffness_terms.hpp, linearised at `state` (null: at rest), projected
+// onto the levels `builds`, all in one sweep of the terms. The threads split each level's
+// points along z by the same lattice layers, each sweeping the terms that reach its own points
+// (each term computed once for all levels), so the sums do not depend on the number of threads.
+void assemble_levels(const lattice::Lattice& lattice, const Eigen::Matrix3Xd* state,
+                     const DofMap& map, double volume_force_factor, double scale,
+                     std::vector<LevelBuild>& builds) {
+  const Dims fine = lattice.shape.nodes;
+  for (LevelBuild& build : builds) {
+    const std::int64_t count = point_count(build.points);
+    build.sums.diagonal.assign(static_cast<std::size_t>(3 * count), 0.0);
+    if (build.exact) {
+      build.sums.blocks.assign(static_cast<std::size_t>(count * kNeighbours * 9), 0.0);
+    }
+  }
   std::exception_ptr failure;
 #pragma omp parallel if (point_count(fine) >= 20000)
   {
     const int parts = omp_get_num_threads();
     const int part = omp_get_thread_num();
-    // This thread's points: those on the lattice layers [part, part + 1) nz / parts along z (the
-    // longest axis of the chapter's boxes, so the terms that two threads both sweep are few).
-    const auto from_part = [&](int jz, int which) {
-      return static_cast<std::int64_t>(z_planes[static_cast<std::size_t>(jz)]) * parts >=
-             static_cast<std::int64_t>(which) * fine[2];
-    };
-    int first = 0;
-    while (first < z_points && !from_part(first, part)) ++first;
-    int end = first;
-    while (end < z_points && !from_part(end, part + 1)) ++end;
-    if (first < end) {
-      try {
-        LevelAssembler level(planes, fine, points, map, sums, first, end);
-        // The lattice layers whose terms reach these points: between the neighbouring points.
-        const int z_first = first > 0 ? z_planes[static_cast<std::size_t>(first) - 1] : 0;
-        const int z_last = end < z_points ? z_planes[static_cast<std::size_t>(end)] : fine[2] - 1;
+    try {
+      // This thread's points on every level: those on the lattice layers [part, part + 1) nz /
+      // parts along z (the longest axis of the chapter's boxes, so the terms that two threads
+      // both sweep are few); on each level the terms that reach them lie in the layers between
+      // the neighbouring points, a band.
+      std::vector<LevelAssembler> levels;
+      std::vector<std::array<int, 2>> bands;
+      int z_first = fine[2];
+      int z_last = -1;
+      for (LevelBuild& build : builds) {
+        const std::vector<int>& z_planes = build.planes[2];
+        const auto z_points = static_cast<int>(z_planes.size());
+        const auto from_part = [&](int jz, int which) {
+          return static_cast<std::int64_t>(z_planes[static_cast<std::size_t>(jz)]) * parts >=
+                 static_cast<std::int64_t>(which) * fine[2];
+        };
+        int first = 0;
+        while (first < z_points && !from_part(first, part)) ++first;
+        int end = first;
+        while (end < z_points && !from_part(end, part + 1)) ++end;
+        if (first == end) continue;
+        levels.emplace_back(build.planes, fine, build.points, build.sums, first, end);
+        const int low = first > 0 ? z_planes[static_cast<std::size_t>(first) - 1] : 0;
+        const int high = end < z_points ? z_planes[static_cast<std::size_t>(end)] : fine[2] - 1;
+        bands.push_back({low, high});
+        z_first = std::min(z_first, low);
+        z_last = std::max(z_last, high);
+      }
+      const NodeLocator locator(fine, map);
+      TermNodes term;
+      // Each level that the term reaches within its band takes it.
+      const auto project = [&](auto&& add_nodes, double c) {
+        for (std::size_t l = 0; l < levels.size(); ++l) {
+          if (term.z_high < bands[l][0] || term.z_low > bands[l][1]) continue;
+          levels[l].start(term);
+          add_nodes(levels[l]);
+          levels[l].add_term(c);
+        }
+      };
+      if (!levels.empty()) {
         for_each_stiffness_term_in_layers(
             lattice, state, map, volume_force_factor, scale, z_first, z_last,
-            [&level](std::int64_t i, std::int64_t j, const Eigen::Vector3d& u, double c) {
-              level.start(std::array<std::int64_t, 2>{j, i});
-              level.add_node(0, u, 1.0);
-              level.add_node(1, u, -1.0);
-              level.add_term(c);
+            [&](std::int64_t i, std::int64_t j, const Eigen::Vector3d& u, double c) {
+              locator.locate(std::array<std::int64_t, 2>{j, i}, term);
+              project(
+                  [&u](LevelAssembler& level) {
+                    level.add_node(0, u, 1.0);
+                    level.add_node(1, u, -1.0);
+                  },
+                  c);
             },
-            [&level](const auto& element, const lattice::CellVertices& g, double c) {
+            [&](const auto& element, const lattice::CellVertices& g, double c) {
               std::array<std::int64_t, 8> nodes{};
               for (std::size_t v = 0; v < 8; ++v) nodes[v] = element[v];
-              level.start(nodes);
-              for (std::size_t v = 0; v < 8; ++v) level.add_node(v, g[v], 1.0);
-              level.add_term(c);
+              locator.locate(nodes, term);
+              project(
+                  [&g](LevelAssembler& level) {
+                    for (std::size_t v = 0; v < 8; ++v) level.add_node(v, g[v], 1.0);
+                  },
+                  c);
             });
-      } catch (...) {
-#pragma omp critical(mresim_multilevel_assembly)
-        failure = std::current_exception();
       }
+    } catch (...) {
+#pragma omp critical(mresim_multilevel_assembly)
+      failure = std::current_exception();
     }
   }
   if (failure) std::rethrow_exception(failure);
-  return sums;
 }
 
 // The process that builds each level when `processes` share the build: the levels in build
@@ -512,7 +583,7 @@ std::vector<int> level_owners(std::int64_t count, int processes) {
 void MultilevelCorrection::assemble(const lattice::Lattice& lattice, double volume_force_factor,
                                     double scale, const DofMap& map, const Eigen::Matrix3Xd* state,
                                     const detail::BlockSplit* processes) {
-  // The levels one after the other, each split over the threads by its points (assemble_level).
+  // All levels in one sweep of the terms, split over the threads by points (assemble_levels).
   // Over several processes each builds its own levels (level_owners) and shares them.
   std::exception_ptr failure;
   const auto count = static_cast<std::int64_t>(levels_.size());
@@ -521,17 +592,31 @@ void MultilevelCorrection::assemble(const lattice::Lattice& lattice, double volu
   const int rank = shared ? processes->rank() : 0;
   std::vector<double> coarsest;  // shared: the coarsest level's diagonal, then its blocks
   std::vector<char> failed(static_cast<std::size_t>(count), 0);
-  for (std::int64_t order = 0; order < count; ++order) {
-    const std::int64_t li = count - 1 - order;
+  std::vector<std::int64_t> mine;  // the levels this process builds
+  std::vector<LevelBuild> builds;
+  for (std::int64_t li = 0; li < count; ++li) {
     if (owner[static_cast<std::size_t>(li)] != rank) continue;
+    const Level& level = levels_[static_cast<std::size_t>(li)];
+    mine.push_back(li);
+    builds.push_back({{level.axes[0].plane, level.axes[1].plane, level.axes[2].plane},
+                      level.points,
+                      li + 1 == count,
+                      {}});
+  }
+  try {
+    assemble_levels(lattice, state, map, volume_force_factor, scale, builds);
+  } catch (...) {
+    failure = std::current_exception();
+    for (const std::int64_t li : mine) failed[static_cast<std::size_t>(li)] = 1;
+    builds.clear();
+  }
+  for (std::size_t b = 0; b < builds.size(); ++b) {
+    const std::int64_t li = mine[b];
     try {
       Level& level = levels_[static_cast<std::size_t>(li)];
-      const bool exact = li + 1 == count;
+      const LevelSums& sums = builds[b].sums;
       const std::int64_t points = point_count(level.points);
-      const LevelSums sums = assemble_level(
-          lattice, state, map, volume_force_factor, scale,
-          {level.axes[0].plane, level.axes[1].plane, level.axes[2].plane}, level.points, exact);
-      if (exact) {
+      if (builds[b].exact) {
         if (shared) {
           coarsest = sums.diagonal;
           coarsest.insert(coarsest.end(), sums.blocks.begin(), sums.blocks.end());
