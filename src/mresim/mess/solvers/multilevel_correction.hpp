@@ -34,16 +34,16 @@
 // at 285k nodes); while C is applied, the sweeps' transient arrays (18 bytes per node) and the
 // levels' fields. The free coordinates are read through the minimiser's DofMap, which add_to()
 // is given, instead of a copy of its map. Building it sweeps the lattice's springs and cells
-// once per level (each a rank-one term: stiffness_terms.hpp), projecting each term onto the
-// 3 x 3 x 3 level points around it; the coarsest level also sums the lower triangle of its
+// once (each a rank-one term: stiffness_terms.hpp), projecting each term onto the 3 x 3 x 3
+// points around it on every level; the coarsest level also sums the lower triangle of its
 // neighbour blocks (all its sparse factor reads), the larger part of the build. The threads
 // split each level's points along z, each sweeping the terms that reach its own points (a band
 // of lattice layers), so every sum takes its terms in index order whatever the number of
-// threads: about 6 s at 993k nodes on 2 threads, 8.5 s when each thread built whole levels
-// (bench/preconditioner_bench.cpp, docs/performance.md). It depends on the lattice, the free
-// coordinates, the force scale and the state; a run builds one at a relaxation's starting state and
-// keeps it while the lattice stays close to that state (PreconditionerCache,
-// preconditioner_cache.hpp).
+// threads: about 6 s at 993k nodes on 2 threads of a slow machine, 8.5 s there when each thread
+// built whole levels (bench/preconditioner_bench.cpp, docs/performance.md). It depends on the
+// lattice, the free coordinates, the force scale and the state; a run builds one at a
+// relaxation's starting state and keeps it while the lattice stays close to that state
+// (PreconditionerCache, preconditioner_cache.hpp).
 //
 // Over MPI processes (a BlockSplit of more than one process, docs/mpi.md) the levels are
 // built by different processes, each level by one, the coarsest by the first, and shared
