@@ -22,6 +22,7 @@ namespace mess = mresim::mess;
 namespace lat = mresim::lattice;
 using mess::testing::apply_correction;
 using mess::testing::faces_held;
+using mess::testing::perturbed;
 using mess::testing::small_lattice;
 using mess::testing::tesla;
 using mess::testing::uniform_random_vector;
@@ -295,12 +296,7 @@ TEST(MultilevelCorrection, ItsBuildSplitOverTheThreadsIsBitwiseTheSameAtADeforme
   ASSERT_GE(l.node_count(), 20000);  // the build's threads start from 20,000 nodes
   sys.set_constraints(faces_held(l, {lat::Face::bottom, lat::Face::top}));
   const mess::DofMap map(sys.constraints(), l.positions, l.element_length);
-  Eigen::Matrix3Xd x = l.positions;
-  std::mt19937 gen(23);
-  std::uniform_real_distribution<double> u(-0.1, 0.1);
-  for (Eigen::Index n = 0; n < x.cols(); ++n) {
-    for (int a = 0; a < 3; ++a) x(a, n) += u(gen) * l.element_length;
-  }
+  const Eigen::Matrix3Xd x = perturbed(l.positions, 0.1 * l.element_length, 23);
   const double factor = sys.settings().elastic.volume_force_factor;
   const int threads = omp_get_max_threads();
   omp_set_num_threads(1);

@@ -14,7 +14,6 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <random>
 #include <tuple>
 #include <vector>
 
@@ -23,6 +22,7 @@
 namespace mess = mresim::mess;
 namespace lat = mresim::lattice;
 using mess::testing::faces_held;
+using mess::testing::perturbed;
 using mess::testing::small_lattice;
 
 namespace {
@@ -54,12 +54,7 @@ TEST(StiffnessTerms, ABandOfLayersHoldsEveryTermThatReachesItInTheWholeSweepsOrd
   const lat::Lattice& l = sys.lattice();
   sys.set_constraints(faces_held(l, {lat::Face::bottom}));
   const mess::DofMap map(sys.constraints(), l.positions, l.element_length);
-  Eigen::Matrix3Xd x = l.positions;
-  std::mt19937 gen(3);
-  std::uniform_real_distribution<double> u(-0.1, 0.1);
-  for (Eigen::Index n = 0; n < x.cols(); ++n) {
-    for (int a = 0; a < 3; ++a) x(a, n) += u(gen) * l.element_length;
-  }
+  const Eigen::Matrix3Xd x = perturbed(l.positions, 0.1 * l.element_length, 3);
   const int nz = l.shape.nodes[2];
   const std::vector<VisitedTerm> whole = visit_layers(l, x, map, 0, nz - 1);
   ASSERT_EQ(whole.size(), l.springs.size() + l.elements.size());
