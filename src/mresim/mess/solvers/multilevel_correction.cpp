@@ -287,17 +287,13 @@ class LevelAssembler {
  public:
   LevelAssembler(const std::array<std::vector<int>, 3>& planes, const Dims& fine,
                  const Dims& points, LevelSums& sums, int owned_first, int owned_end)
-      : fine_(fine),
-        points_(points),
-        sums_(sums),
-        owned_first_(owned_first),
-        owned_end_(owned_end) {
+      : points_(points), sums_(sums), owned_first_(owned_first), owned_end_(owned_end) {
     // Each lattice plane's bracket on this level: the composition of the levels' linear
     // interpolations is the linear interpolation in lattice coordinates (nested grids).
     for (std::size_t a = 0; a < 3; ++a) {
       const std::vector<int>& plane = planes[a];
       std::size_t j = 0;
-      for (int f = 0; f < fine_[a]; ++f) {
+      for (int f = 0; f < fine[a]; ++f) {
         while (j + 2 < plane.size() && plane[j + 1] <= f) ++j;
         const double t = static_cast<double>(f - plane[j]) / (plane[j + 1] - plane[j]);
         lower_[a].push_back(static_cast<int>(j));
@@ -444,7 +440,6 @@ class LevelAssembler {
     return jz + points_[2] * (jx + static_cast<std::int64_t>(points_[0]) * jy);
   }
 
-  Dims fine_;
   Dims points_;
   LevelSums& sums_;
   int owned_first_;
